@@ -1,0 +1,82 @@
+#pragma once
+// Satellite position, velocity and clock from broadcast ephemerides.
+//
+// Kepler orbits (GPS, Galileo, BeiDou MEO/IGSO and GEO, QZSS) per the ICDs; GLONASS by 4th-order Runge-Kutta
+// integration of the PZ-90 state with J2 and the broadcast lunisolar acceleration. Positions are in the ECEF frame
+// at the instant of transmission (the Earth-rotation correction during signal flight depends on the receiver and is
+// applied by geometric_range_m()). Clock bias includes the relativistic eccentricity correction and excludes group
+// delays (see group_delay_s()).
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/ephemeris.hpp"
+#include "canyon/core/satellite.hpp"
+#include "canyon/core/time.hpp"
+
+namespace canyon::gnss {
+
+struct SatelliteState {
+  core::SatelliteId sat;
+  Eigen::Vector3d p_E_m = Eigen::Vector3d::Zero();    ///< ECEF at transmission time
+  Eigen::Vector3d v_E_mps = Eigen::Vector3d::Zero();  ///< ECEF velocity (rotating frame)
+  double clock_bias_s = 0.0;       ///< satellite clock minus system time, relativity included, no group delay
+  double clock_drift_sps = 0.0;
+  double variance_m2 = 0.0;        ///< ephemeris/clock error variance from URA/SISA
+  int iode = 0;
+  int glonass_channel = core::kNoGlonassChannel;
+};
+
+struct EphemerisOptions {
+  bool use_unhealthy = false;  ///< also use satellites flagged unhealthy
+  /// Maximum |t - toe| (s) per system before an ephemeris is too old; GLONASS 30 min, Kepler orbits 4 h (BeiDou 6 h
+  /// in RTKLIB; here as for GPS unless the fit interval says more).
+  double max_age_kepler_s = 4.0 * 3600.0 + 60.0;
+  double max_age_glonass_s = 1800.0 + 60.0;
+};
+
+/// Owns the navigation data and answers satellite states. Thread-compatible (const methods are safe to share).
+class EphemerisStore {
+ public:
+  explicit EphemerisStore(core::NavigationData nav, EphemerisOptions options = {});
+
+  /// The ephemeris to use for `sat` at GPST `t`: healthy, within its validity, nearest toe (Galileo: I/NAV
+  /// preferred). nullptr if none.
+  [[nodiscard]] const core::KeplerEphemeris* select_kepler(core::SatelliteId sat, core::GpsTime t) const;
+  [[nodiscard]] const core::GlonassEphemeris* select_glonass(core::SatelliteId sat, core::GpsTime t) const;
+
+  /// Broadcast state of `sat` at GPST transmission time `t_tx`. nullopt if no usable ephemeris.
+  [[nodiscard]] std::optional<SatelliteState> state(core::SatelliteId sat, core::GpsTime t_tx) const;
+
+  /// State at the transmission time of a signal received at GPST `t_rx` with pseudorange `pseudorange_m`:
+  /// t_tx = t_rx - P / c - dt_sat(t_tx), iterated. Writes t_tx if asked.
+  [[nodiscard]] std::optional<SatelliteState> state_at_reception(core::SatelliteId sat, core::GpsTime t_rx,
+                                                                 double pseudorange_m,
+                                                                 core::GpsTime* t_tx = nullptr) const;
+
+  /// Group delay (s) to subtract from a pseudorange on `signal` relative to the system's clock reference:
+  /// GPS/QZSS TGD scaled by (f_L1 / f)^2; Galileo BGD(E1,E5a) for F/NAV, BGD(E1,E5b) for I/NAV; BeiDou TGD1/TGD2 on
+  /// B1I/B2I (0 on B3I, the clock reference). 0 when unknown.
+  [[nodiscard]] double group_delay_s(core::SatelliteId sat, core::SignalCode signal, core::GpsTime t) const;
+
+  /// FDMA channel of a GLONASS slot (kNoGlonassChannel if no ephemeris carries it).
+  [[nodiscard]] int glonass_channel(int slot) const;
+
+  [[nodiscard]] const core::NavigationData& nav() const { return nav_; }
+
+ private:
+  core::NavigationData nav_;
+  EphemerisOptions options_;
+  // Indices per satellite (by SatelliteId::index()) into nav_ for fast selection.
+  std::vector<std::vector<int>> kepler_by_sat_;
+  std::vector<std::vector<int>> glonass_by_sat_;
+};
+
+/// Geometric range (m) from a receiver at p_E_rcv to a satellite at p_E_sat (ECEF at transmission time), with the
+/// Earth-rotation (Sagnac) correction for the signal's flight. Writes the unit line of sight rcv -> sat if asked.
+[[nodiscard]] double geometric_range_m(const Eigen::Vector3d& p_E_sat, const Eigen::Vector3d& p_E_rcv,
+                                       Eigen::Vector3d* los_E = nullptr);
+
+}  // namespace canyon::gnss
