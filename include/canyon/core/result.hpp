@@ -11,6 +11,10 @@ namespace canyon {
 
 /// What went wrong and where: a file and line for input data, empty when not about a file.
 struct Error {
+  Error() = default;
+  Error(std::string message_, std::string file_ = {}, int line_ = 0)  // NOLINT(google-explicit-constructor)
+      : message(std::move(message_)), file(std::move(file_)), line(line_) {}
+
   std::string message;  ///< human-readable cause, e.g. "bad satellite number 'G9x'"
   std::string file;     ///< input file path, or empty
   int line = 0;         ///< 1-based line number in `file`, 0 when not applicable

@@ -1,0 +1,28 @@
+#pragma once
+// `canyon process`: batch processing of recorded observations into a solution file.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "canyon/app/process_config.hpp"
+#include "canyon/core/result.hpp"
+
+namespace canyon::app {
+
+struct ProcessSummary {
+  int epochs = 0;             ///< rover epochs read
+  int solved = 0;             ///< epochs with a solution written
+  double wall_s = 0.0;        ///< wall-clock time of the whole run
+  std::vector<std::string> warnings;       ///< recovered input defects, "file:line: what"
+  std::vector<std::string> unsolved_reasons;  ///< one line per unsolved epoch, "week tow: reason" (first 100)
+};
+
+/// Called after each epoch with (epochs done, epochs in total).
+using ProgressFn = std::function<void(int, int)>;
+
+/// Runs the configured mode over the whole input. Error (file and line) if an input cannot be read or the output
+/// cannot be written; an epoch that cannot be solved is counted and skipped.
+Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn& progress = {});
+
+}  // namespace canyon::app

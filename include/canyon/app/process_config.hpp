@@ -1,0 +1,61 @@
+#pragma once
+// Configuration of `canyon process`: inputs, mode, output format and the estimator options, from a strict YAML
+// file and/or the command line. Relative paths in a YAML file are relative to that file's folder.
+//
+// YAML keys (all optional; the command line overrides them):
+//   mode: spp                      # processing mode (spp; rtk and fusion come with later modules)
+//   rover: ROVER.obs               # rover RINEX observations (2.x/3.x, may be .gz)
+//   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
+//   out: SOL.pos                   # solution file (RTKLIB .pos format)
+//   output:
+//     coordinates: llh             # llh | ecef
+//     time_format: tow             # tow (GPST week, seconds) | calendar (yyyy/mm/dd hh:mm:ss.sss)
+//   spp:
+//     elevation_mask_deg: 15       # deg
+//     systems: [G, R, E, C, J]     # constellations to use
+//     ionosphere: klobuchar        # klobuchar | off
+//     troposphere: saastamoinen    # saastamoinen | off
+//     code_sigma_m: 0.3            # zenith pseudorange noise (m)
+//     raim_fde: true               # exclude one faulty satellite when the chi-square test fails
+//     max_gdop: 30                 # reject solutions with a larger GDOP
+//     qzss_own_clock: false        # false: QZSS shares the GPS receiver clock
+//     exclude: [G05]               # satellites never used
+
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "canyon/core/result.hpp"
+#include "canyon/gnss/spp.hpp"
+#include "canyon/io/pos_file.hpp"
+
+namespace canyon::app {
+
+enum class ProcessMode { Spp };
+
+struct ProcessConfig {
+  ProcessMode mode = ProcessMode::Spp;
+  std::string rover_obs;          ///< rover observation file
+  std::vector<std::string> nav;   ///< navigation files
+  std::string out;                ///< solution file
+  io::PosCoordinates coordinates = io::PosCoordinates::Llh;
+  io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
+  gnss::SppOptions spp;
+
+  /// Empty if complete and consistent, else the first violated rule ("rover observation file is required").
+  [[nodiscard]] std::string validate() const;
+};
+
+[[nodiscard]] bool operator==(const ProcessConfig& a, const ProcessConfig& b);
+
+/// Parses a YAML node; `file` names the source in errors and anchors relative paths.
+Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file,
+                                           ProcessConfig defaults = {});
+Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig defaults = {});
+/// The configuration as YAML that parse_process_config() reads back to an equal configuration.
+[[nodiscard]] std::string to_yaml(const ProcessConfig& config);
+
+[[nodiscard]] std::string mode_name(ProcessMode mode);
+
+}  // namespace canyon::app

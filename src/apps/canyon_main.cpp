@@ -1,0 +1,140 @@
+// The `canyon` command: subcommands for canyon's jobs. Exit codes: 0 success, 1 bad input or failed run,
+// 2 bad command line or configuration.
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include <spdlog/spdlog.h>
+
+#include "canyon/app/process.hpp"
+#include "canyon/app/process_config.hpp"
+#include "canyon/core/constants.hpp"
+
+namespace {
+
+constexpr int kExitInput = 1;
+constexpr int kExitUsage = 2;
+
+/// A one-line progress bar on a terminal; nothing when stderr is not a terminal (logs, CI).
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled && isatty(fileno(stderr)) != 0) {}
+  void update(int done, int total) {
+    if (!enabled_ || total <= 0) return;
+    const int percent = static_cast<int>(100LL * done / total);
+    if (percent == last_percent_ && done != total) return;
+    last_percent_ = percent;
+    constexpr int kWidth = 40;
+    const int filled = kWidth * done / total;
+    std::fprintf(stderr, "\r[%.*s%*s] %3d%% %d/%d epochs", filled, "########################################",
+                 kWidth - filled, "", percent, done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_;
+  int last_percent_ = -1;
+};
+
+struct ProcessArgs {
+  std::string config_file;
+  std::string mode;
+  std::string rover;
+  std::vector<std::string> nav;
+  std::string out;
+  std::string coordinates;
+  std::string time_format;
+  double elevation_mask_deg = -1.0;
+  bool print_config = false;
+  bool quiet = false;
+};
+
+void add_process_command(CLI::App& app, ProcessArgs& args) {
+  CLI::App* cmd = app.add_subcommand("process", "Process recorded observations into a solution file (.pos)");
+  cmd->add_option("--config", args.config_file, "YAML configuration (strict: unknown keys are errors)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--mode", args.mode, "Processing mode: spp")->check(CLI::IsMember({"spp"}));
+  cmd->add_option("--rover", args.rover, "Rover RINEX observation file (2.x/3.x, may be gzip-compressed)");
+  cmd->add_option("--nav", args.nav, "RINEX navigation file (repeat for several)");
+  cmd->add_option("--out", args.out, "Solution file, RTKLIB .pos format");
+  cmd->add_option("--coordinates", args.coordinates, "Output coordinates: llh or ecef")
+      ->check(CLI::IsMember({"llh", "ecef"}));
+  cmd->add_option("--time-format", args.time_format, "Output time: tow (GPST week, s) or calendar")
+      ->check(CLI::IsMember({"tow", "calendar"}));
+  cmd->add_option("--elevation-mask-deg", args.elevation_mask_deg, "Elevation mask (deg), default 15")
+      ->check(CLI::Range(0.0, 89.9));
+  cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
+  cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
+}
+
+int run_process_command(const ProcessArgs& args) {
+  using canyon::app::ProcessConfig;
+  ProcessConfig config;
+  if (!args.config_file.empty()) {
+    auto loaded = canyon::app::load_process_config(args.config_file);
+    if (!loaded) {
+      std::cerr << "canyon: error: " << loaded.error().to_string() << "\n";
+      return kExitUsage;
+    }
+    config = std::move(*loaded);
+  }
+  if (!args.rover.empty()) config.rover_obs = args.rover;
+  if (!args.nav.empty()) config.nav = args.nav;
+  if (!args.out.empty()) config.out = args.out;
+  if (!args.coordinates.empty()) {
+    config.coordinates = args.coordinates == "ecef" ? canyon::io::PosCoordinates::Ecef : canyon::io::PosCoordinates::Llh;
+  }
+  if (!args.time_format.empty()) {
+    config.time_format =
+        args.time_format == "calendar" ? canyon::io::PosTimeFormat::Calendar : canyon::io::PosTimeFormat::WeekTow;
+  }
+  if (args.elevation_mask_deg >= 0.0) config.spp.elevation_mask_rad = args.elevation_mask_deg * canyon::core::kDegToRad;
+  if (args.print_config) {
+    std::cout << canyon::app::to_yaml(config);
+    return 0;
+  }
+  if (const std::string e = config.validate(); !e.empty()) {
+    std::cerr << "canyon: error: " << e << "\n";
+    return kExitUsage;
+  }
+  ProgressBar bar(!args.quiet);
+  auto summary = canyon::app::run_process(config, [&bar](int done, int total) { bar.update(done, total); });
+  if (!summary) {
+    std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
+    return kExitInput;
+  }
+  for (const std::string& w : summary->warnings) spdlog::warn("{}", w);
+  if (!args.quiet) {
+    const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;
+    std::fprintf(stderr, "canyon process: %d epochs, %d solved (%.1f %%), %.2f s wall, solution: %s\n",
+                 summary->epochs, summary->solved, percent, summary->wall_s, config.out.c_str());
+  }
+  return summary->solved > 0 ? 0 : kExitInput;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"canyon: centimetre-level GNSS carrier-phase positioning fused with visual-inertial odometry"};
+  app.require_subcommand(1);
+  ProcessArgs process_args;
+  add_process_command(app, process_args);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitUsage;
+  }
+  spdlog::set_pattern("canyon: %l: %v");
+  if (app.got_subcommand("process")) return run_process_command(process_args);
+  return kExitUsage;
+}

@@ -1,0 +1,372 @@
+// Single-point positioning: weighted least squares on pseudoranges with one receiver clock per constellation,
+// RAIM fault detection and exclusion, DOP, and velocity from Doppler. The model is stated in spp.hpp.
+
+#include "canyon/gnss/spp.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string_view>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/core/geodesy.hpp"
+#include "canyon/gnss/atmosphere.hpp"
+
+namespace canyon::gnss {
+namespace {
+
+using core::Constellation;
+using core::SatelliteId;
+
+constexpr int kNumClocks = core::kNumConstellations;
+constexpr double kMinSinElevation = 0.05;  // floor for the elevation weighting near the horizon
+
+/// One pseudorange measurement prepared for the least squares.
+struct Measurement {
+  SatelliteId sat;
+  int clock = 0;  // index of the receiver clock this measurement depends on
+  double pseudorange_m = 0.0;
+  double doppler_hz = core::kNoValue;
+  double wavelength_m = 0.0;
+  double group_delay_m = 0.0;
+  double iono_scale = 1.0;  // (f_L1 / f)^2: Klobuchar is an L1 delay
+  SatelliteState state;
+};
+
+/// Linearised system at one position.
+struct Linearised {
+  Eigen::MatrixXd H;          // n x (3 + clocks in use)
+  Eigen::VectorXd v;          // residuals (m)
+  Eigen::VectorXd variance;   // per measurement (m^2)
+  std::vector<int> rows;      // measurement index of each row
+  std::array<int, kNumClocks> clock_column{};  // column of each clock, -1 if unused
+  int num_clocks = 0;
+};
+
+/// Preferred tracking attributes on each system's first frequency, best first.
+std::string_view attribute_priority(Constellation system) {
+  switch (system) {
+    case Constellation::Gps: return "CPYWMLSX";
+    case Constellation::Glonass: return "CP";
+    case Constellation::Galileo: return "CBXAZ";
+    case Constellation::BeiDou: return "IQX";
+    case Constellation::Qzss: return "CSLXZ";
+  }
+  return "";
+}
+
+bool system_enabled(Constellation system, const SppOptions& o) {
+  switch (system) {
+    case Constellation::Gps: return o.use_gps;
+    case Constellation::Glonass: return o.use_glonass;
+    case Constellation::Galileo: return o.use_galileo;
+    case Constellation::BeiDou: return o.use_beidou;
+    case Constellation::Qzss: return o.use_qzss;
+  }
+  return false;
+}
+
+/// The first-frequency signal with a pseudorange, by attribute priority.
+const core::SignalObs* select_signal(const core::SatelliteObs& sat_obs) {
+  const core::SignalObs* best = nullptr;
+  std::size_t best_rank = std::string_view::npos;
+  const std::string_view priority = attribute_priority(sat_obs.sat.system);
+  for (const core::SignalObs& s : sat_obs.signals) {
+    if (!core::has_value(s.pseudorange_m) || s.pseudorange_m < 1e6 || s.pseudorange_m > 1e8) continue;
+    if (core::frequency_rank(sat_obs.sat.system, s.code.band) != 0) continue;
+    const std::size_t pos = priority.find(s.code.attribute);
+    const std::size_t rank = pos == std::string_view::npos ? priority.size() : pos;
+    if (best == nullptr || rank < best_rank) {
+      best = &s;
+      best_rank = rank;
+    }
+  }
+  return best;
+}
+
+int clock_index(Constellation system, const SppOptions& o) {
+  if (system == Constellation::Qzss && !o.qzss_own_clock) return static_cast<int>(Constellation::Gps);
+  return static_cast<int>(system);
+}
+
+std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const EphemerisStore& eph,
+                                              const SppOptions& options) {
+  std::vector<Measurement> out;
+  out.reserve(epoch.sats.size());
+  for (const core::SatelliteObs& sat_obs : epoch.sats) {
+    if (!system_enabled(sat_obs.sat.system, options)) continue;
+    if (std::find(options.excluded.begin(), options.excluded.end(), sat_obs.sat) != options.excluded.end()) continue;
+    const core::SignalObs* signal = select_signal(sat_obs);
+    if (signal == nullptr) continue;
+    const auto state = eph.state_at_reception(sat_obs.sat, epoch.time, signal->pseudorange_m);
+    if (!state) continue;
+    const int channel = sat_obs.sat.system == Constellation::Glonass ? eph.glonass_channel(sat_obs.sat.prn)
+                                                                      : core::kNoGlonassChannel;
+    const auto frequency = core::carrier_frequency_hz(sat_obs.sat.system, signal->code, channel);
+    Measurement m;
+    m.sat = sat_obs.sat;
+    m.clock = clock_index(sat_obs.sat.system, options);
+    m.pseudorange_m = signal->pseudorange_m;
+    m.doppler_hz = signal->doppler_hz;
+    m.wavelength_m = frequency ? core::kSpeedOfLightMps / *frequency : 0.0;
+    m.iono_scale = frequency ? std::pow(1575.42e6 / *frequency, 2) : 1.0;
+    m.group_delay_m = core::kSpeedOfLightMps * eph.group_delay_s(sat_obs.sat, signal->code, epoch.time);
+    m.state = *state;
+    out.push_back(m);
+  }
+  return out;
+}
+
+/// Builds H, v and variances at position x (3 + kNumClocks), skipping measurements below the mask and excluded
+/// ones. `have_position` false means x is not yet a position on the ground: no mask, no atmosphere.
+Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>& active, const Eigen::VectorXd& x,
+                     const core::GpsTime& t, const EphemerisStore& eph, const SppOptions& options) {
+  const Eigen::Vector3d p_E = x.head<3>();
+  const bool have_position = p_E.norm() > 6.0e6 && p_E.norm() < 7.0e6;
+  const core::Geodetic rcv = core::ecef_to_geodetic(p_E);
+  const core::KlobucharParams klob = eph.nav().gps_klobuchar.value_or(default_klobuchar());
+
+  Linearised lin;
+  lin.clock_column.fill(-1);
+  std::vector<Eigen::RowVectorXd> rows;
+  std::vector<double> residuals;
+  std::vector<double> variances;
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    if (!active[i]) continue;
+    const Measurement& m = ms[i];
+    Eigen::Vector3d los_E;
+    const double range_m = geometric_range_m(m.state.p_E_m, p_E, &los_E);
+    double sin_el = 1.0;
+    double iono_m = 0.0;
+    double tropo_m = 0.0;
+    if (have_position) {
+      const core::AzEl azel = core::azimuth_elevation(p_E, rcv, m.state.p_E_m);
+      if (azel.elevation_rad < options.elevation_mask_rad) continue;
+      sin_el = std::max(std::sin(azel.elevation_rad), kMinSinElevation);
+      if (options.ionosphere_klobuchar) iono_m = m.iono_scale * klobuchar_delay_m(t, rcv, azel, klob);
+      if (options.troposphere_saastamoinen) tropo_m = saastamoinen_delay_m(rcv, azel.elevation_rad);
+    }
+    if (lin.clock_column[static_cast<std::size_t>(m.clock)] < 0) {
+      lin.clock_column[static_cast<std::size_t>(m.clock)] = lin.num_clocks++;
+    }
+    const double clock_m = x[3 + m.clock];
+    const double predicted_m = range_m + clock_m - core::kSpeedOfLightMps * m.state.clock_bias_s +
+                               m.group_delay_m + iono_m + tropo_m;
+    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(3 + kNumClocks);
+    row.head<3>() = -los_E.transpose();
+    row[3 + m.clock] = 1.0;
+    rows.push_back(row);
+    residuals.push_back(m.pseudorange_m - predicted_m);
+    const double sigma2 = options.code_sigma_m * options.code_sigma_m * (1.0 + 1.0 / (sin_el * sin_el));
+    const double iono_var = options.ionosphere_klobuchar ? std::pow(0.5 * iono_m, 2) : std::pow(5.0 * m.iono_scale, 2);
+    const double tropo_var = options.troposphere_saastamoinen ? std::pow(0.3 / (sin_el + 0.1), 2) : 6.25;
+    variances.push_back(sigma2 + m.state.variance_m2 + iono_var + tropo_var);
+    lin.rows.push_back(static_cast<int>(i));
+  }
+  // Compress the clock columns to those in use.
+  const int n = static_cast<int>(rows.size());
+  lin.H.resize(n, 3 + lin.num_clocks);
+  lin.v.resize(n);
+  lin.variance.resize(n);
+  for (int r = 0; r < n; ++r) {
+    lin.H.row(r).head<3>() = rows[static_cast<std::size_t>(r)].head<3>();
+    lin.H.row(r).tail(lin.num_clocks).setZero();
+    for (int c = 0; c < kNumClocks; ++c) {
+      const int column = lin.clock_column[static_cast<std::size_t>(c)];
+      if (column >= 0) lin.H(r, 3 + column) = rows[static_cast<std::size_t>(r)][3 + c];
+    }
+    lin.v[r] = residuals[static_cast<std::size_t>(r)];
+    lin.variance[r] = variances[static_cast<std::size_t>(r)];
+  }
+  return lin;
+}
+
+/// Chi-square quantile for p = 0.999 (Wilson-Hilferty approximation; within 3 % of the exact value for dof >= 1).
+double chi_square_999(int dof) {
+  constexpr double kZ999 = 3.090232;
+  const double k = dof;
+  const double a = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - a + kZ999 * std::sqrt(a), 3);
+}
+
+struct Fix {
+  Eigen::VectorXd x;  // 3 + kNumClocks
+  Linearised lin;
+  Eigen::MatrixXd Q;  // (H' W H)^-1
+  double weighted_sum = 0.0;
+  int iterations = 0;
+};
+
+/// Gauss-Newton iterations over the active measurements. Error string if it fails.
+Result<Fix> iterate(const std::vector<Measurement>& ms, const std::vector<bool>& active, Eigen::VectorXd x,
+                    const core::GpsTime& t, const EphemerisStore& eph, const SppOptions& options) {
+  for (int it = 1; it <= options.max_iterations; ++it) {
+    Linearised lin = linearise(ms, active, x, t, eph, options);
+    const int n = static_cast<int>(lin.v.size());
+    const int m = 3 + lin.num_clocks;
+    if (n < m || lin.num_clocks == 0) {
+      return Error{"too few satellites: " + std::to_string(n) + " usable for " + std::to_string(m) + " unknowns"};
+    }
+    const Eigen::VectorXd w = lin.variance.cwiseInverse();
+    const Eigen::MatrixXd HtW = lin.H.transpose() * w.asDiagonal();
+    const Eigen::MatrixXd N = HtW * lin.H;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(N);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return Error{"singular geometry"};
+    const Eigen::VectorXd dx = ldlt.solve(HtW * lin.v);
+    x.head<3>() += dx.head<3>();
+    for (int c = 0; c < kNumClocks; ++c) {
+      const int column = lin.clock_column[static_cast<std::size_t>(c)];
+      if (column >= 0) x[3 + c] += dx[3 + column];
+    }
+    if (dx.norm() < options.convergence_m) {
+      Fix fix;
+      fix.lin = linearise(ms, active, x, t, eph, options);  // residuals at the solution
+      if (fix.lin.v.size() != lin.v.size()) continue;     // the mask changed the set at the last step: go on
+      fix.x = x;
+      fix.Q = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
+      fix.weighted_sum = fix.lin.v.dot(fix.lin.v.cwiseQuotient(fix.lin.variance));
+      fix.iterations = it;
+      return fix;
+    }
+  }
+  return Error{"no convergence in " + std::to_string(options.max_iterations) + " iterations"};
+}
+
+bool passes_chi_square(const Fix& fix) {
+  const int dof = static_cast<int>(fix.lin.v.size()) - static_cast<int>(fix.lin.H.cols());
+  return dof <= 0 || fix.weighted_sum < chi_square_999(dof);
+}
+
+Dop compute_dop(const Linearised& lin, const Eigen::Vector3d& p_E) {
+  // DOP from the unweighted geometry in ENU.
+  const core::Geodetic g = core::ecef_to_geodetic(p_E);
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
+  Eigen::MatrixXd G = lin.H;
+  G.leftCols<3>() = lin.H.leftCols<3>() * R_NE.transpose();
+  const Eigen::MatrixXd Q = (G.transpose() * G).inverse();
+  Dop d;
+  d.gdop = std::sqrt(Q.trace());
+  d.pdop = std::sqrt(Q(0, 0) + Q(1, 1) + Q(2, 2));
+  d.hdop = std::sqrt(Q(0, 0) + Q(1, 1));
+  d.vdop = std::sqrt(Q(2, 2));
+  return d;
+}
+
+/// Velocity and clock drift from Doppler of the measurements used in the fix.
+std::optional<Eigen::Vector3d> solve_velocity(const std::vector<Measurement>& ms, const Linearised& lin,
+                                              const Eigen::Vector3d& p_E) {
+  std::vector<int> rows;
+  for (std::size_t r = 0; r < lin.rows.size(); ++r) {
+    const Measurement& m = ms[static_cast<std::size_t>(lin.rows[r])];
+    if (core::has_value(m.doppler_hz) && m.wavelength_m > 0.0) rows.push_back(lin.rows[r]);
+  }
+  if (rows.size() < 5) return std::nullopt;  // 4 unknowns and at least one check
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(4);
+  for (int it = 0; it < 5; ++it) {
+    Eigen::MatrixXd H(rows.size(), 4);
+    Eigen::VectorXd v(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const Measurement& m = ms[static_cast<std::size_t>(rows[r])];
+      Eigen::Vector3d los_E;
+      (void)geometric_range_m(m.state.p_E_m, p_E, &los_E);
+      const Eigen::Vector3d& vs = m.state.v_E_mps;
+      const Eigen::Vector3d vr = x.head<3>();
+      // Range rate with the Earth-rotation term of the Sagnac correction.
+      const double rate = los_E.dot(vs - vr) +
+                          core::kEarthRotationRateRadps / core::kSpeedOfLightMps *
+                              (vs.y() * p_E.x() + m.state.p_E_m.y() * vr.x() - vs.x() * p_E.y() -
+                               m.state.p_E_m.x() * vr.y());
+      const double observed = -m.wavelength_m * m.doppler_hz;
+      v[static_cast<Eigen::Index>(r)] =
+          observed - (rate + x[3] - core::kSpeedOfLightMps * m.state.clock_drift_sps);
+      H.row(static_cast<Eigen::Index>(r)) << -los_E.transpose(), 1.0;
+    }
+    const Eigen::VectorXd dx = (H.transpose() * H).ldlt().solve(H.transpose() * v);
+    x += dx;
+    if (dx.norm() < 1e-6) break;
+  }
+  if (!x.allFinite()) return std::nullopt;
+  return Eigen::Vector3d(x.head<3>());
+}
+
+}  // namespace
+
+std::string SppOptions::validate() const {
+  if (!(elevation_mask_rad >= 0.0 && elevation_mask_rad < core::kPi / 2.0)) {
+    return "elevation_mask_rad must be in [0, pi/2)";
+  }
+  if (!(code_sigma_m > 0.0)) return "code_sigma_m must be > 0";
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (!(convergence_m > 0.0)) return "convergence_m must be > 0";
+  if (!(max_gdop > 0.0)) return "max_gdop must be > 0";
+  if (!(use_gps || use_glonass || use_galileo || use_beidou || use_qzss)) return "at least one system must be used";
+  return {};
+}
+
+Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides,
+                              const SppOptions& options, const std::optional<Eigen::Vector3d>& initial_p_E_m) {
+  const std::vector<Measurement> ms = prepare_measurements(epoch, ephemerides, options);
+  if (ms.size() < 4) {
+    return Error{"too few satellites with pseudorange and ephemeris: " + std::to_string(ms.size())};
+  }
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(3 + kNumClocks);
+  if (initial_p_E_m) x0.head<3>() = *initial_p_E_m;
+
+  std::vector<bool> active(ms.size(), true);
+  auto fix = iterate(ms, active, x0, epoch.time, ephemerides, options);
+  if (!fix) return fix.error();
+
+  std::vector<SatelliteId> excluded_by_raim;
+  if (options.raim_fde && !passes_chi_square(*fix) &&
+      fix->lin.v.size() >= fix->lin.H.cols() + 2) {
+    // Try every single exclusion from the converged position; keep the best that passes.
+    std::optional<Fix> best;
+    std::size_t best_excluded = 0;
+    for (const int row_measurement : fix->lin.rows) {
+      std::vector<bool> trial = active;
+      trial[static_cast<std::size_t>(row_measurement)] = false;
+      auto candidate = iterate(ms, trial, fix->x, epoch.time, ephemerides, options);
+      if (!candidate || !passes_chi_square(*candidate)) continue;
+      if (!best || candidate->weighted_sum < best->weighted_sum) {
+        best = std::move(candidate.value());
+        best_excluded = static_cast<std::size_t>(row_measurement);
+      }
+    }
+    if (best) {
+      excluded_by_raim.push_back(ms[best_excluded].sat);
+      fix = std::move(*best);
+    }
+  }
+
+  SppSolution sol;
+  sol.receiver_time = epoch.time;
+  sol.p_E_m = fix->x.head<3>();
+  sol.P_E_m2 = fix->Q.topLeftCorner<3, 3>();
+  sol.dop = compute_dop(fix->lin, sol.p_E_m);
+  if (sol.dop.gdop > options.max_gdop) {
+    return Error{"GDOP " + std::to_string(sol.dop.gdop) + " exceeds " + std::to_string(options.max_gdop)};
+  }
+  double reference_clock_m = 0.0;
+  bool have_reference = false;
+  for (int c = 0; c < kNumClocks; ++c) {
+    if (fix->lin.clock_column[static_cast<std::size_t>(c)] < 0) continue;
+    sol.clock_bias_m.emplace_back(static_cast<Constellation>(c), fix->x[3 + c]);
+    if (!have_reference) {
+      reference_clock_m = fix->x[3 + c];  // GPS first when present (enum order)
+      have_reference = true;
+    }
+  }
+  sol.time = epoch.time - reference_clock_m / core::kSpeedOfLightMps;
+  for (const int r : fix->lin.rows) sol.used.push_back(ms[static_cast<std::size_t>(r)].sat);
+  sol.num_satellites = static_cast<int>(sol.used.size());
+  sol.excluded_by_raim = std::move(excluded_by_raim);
+  sol.iterations = fix->iterations;
+  sol.residual_rms_m = std::sqrt(fix->lin.v.squaredNorm() / static_cast<double>(fix->lin.v.size()));
+  sol.v_E_mps = solve_velocity(ms, fix->lin, sol.p_E_m);
+  return sol;
+}
+
+}  // namespace canyon::gnss

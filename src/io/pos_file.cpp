@@ -1,0 +1,154 @@
+// RTKLIB-compatible .pos solution files: writer and reader (format in pos_file.hpp).
+
+#include "canyon/io/pos_file.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/core/geodesy.hpp"
+#include "canyon/io/text_reader.hpp"
+
+namespace canyon::io {
+namespace {
+
+double signed_sqrt(double c) { return c < 0.0 ? -std::sqrt(-c) : std::sqrt(c); }
+double signed_square(double s) { return s < 0.0 ? -s * s : s * s; }
+
+std::string format_time(const core::GpsTime& t, PosTimeFormat format) {
+  char buffer[64];
+  // Round to the printed millisecond first so that 59.9996 s does not print as 60.000.
+  core::GpsTime r = t.normalized();
+  r.tow_s = std::round(r.tow_s * 1000.0) / 1000.0;
+  r = r.normalized();
+  if (format == PosTimeFormat::WeekTow) {
+    std::snprintf(buffer, sizeof buffer, "%4d %10.3f", r.week, r.tow_s);
+  } else {
+    const core::CalendarTime c = core::gps_to_calendar(r);
+    std::snprintf(buffer, sizeof buffer, "%04d/%02d/%02d %02d:%02d:%06.3f", c.year, c.month, c.day, c.hour, c.minute,
+                  c.second);
+  }
+  return buffer;
+}
+
+std::string column_titles(PosCoordinates coordinates, PosTimeFormat time_format) {
+  const char* time = time_format == PosTimeFormat::WeekTow ? "%  GPST          " : "%  GPST                  ";
+  if (coordinates == PosCoordinates::Llh) {
+    return std::string(time) +
+           "latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) "
+           "age(s)  ratio";
+  }
+  return std::string(time) +
+         "  x-ecef(m)      y-ecef(m)      z-ecef(m)   Q  ns   sdx(m)   sdy(m)   sdz(m)  sdxy(m)  sdyz(m)  sdzx(m) "
+         "age(s)  ratio";
+}
+
+}  // namespace
+
+Result<PosWriter> PosWriter::create(const std::string& path, PosWriterOptions options) {
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "w"));
+  if (!file) return Error{std::string("cannot create solution file: ") + std::strerror(errno), path, 0};
+  for (const std::string& line : options.header_lines) std::fprintf(file.get(), "%% %s\n", line.c_str());
+  std::fprintf(file.get(), "%%\n%% (%s,Q=1:fix,2:float,5:single,7:vio fill-in,ns=# of satellites)\n",
+               options.coordinates == PosCoordinates::Llh ? "lat/lon/height=WGS84/ellipsoidal" : "x/y/z-ecef=WGS84");
+  std::fprintf(file.get(), "%s\n", column_titles(options.coordinates, options.time_format).c_str());
+  return PosWriter(std::move(file), path, std::move(options));
+}
+
+std::string format_pos_record(const core::Solution& s, PosCoordinates coordinates, PosTimeFormat time_format) {
+  char buffer[256];
+  const std::string time = format_time(s.time, time_format);
+  if (coordinates == PosCoordinates::Llh) {
+    const core::Geodetic g = core::ecef_to_geodetic(s.p_E_m);
+    const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
+    const Eigen::Matrix3d P_N = R_NE * s.P_E_m2 * R_NE.transpose();
+    std::snprintf(buffer, sizeof buffer,
+                  "%s %14.9f %14.9f %10.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f", time.c_str(),
+                  g.lat_rad * core::kRadToDeg, g.lon_rad * core::kRadToDeg, g.height_m, static_cast<int>(s.status),
+                  s.num_satellites, std::sqrt(std::max(P_N(1, 1), 0.0)), std::sqrt(std::max(P_N(0, 0), 0.0)),
+                  std::sqrt(std::max(P_N(2, 2), 0.0)), signed_sqrt(P_N(1, 0)), signed_sqrt(P_N(0, 2)),
+                  signed_sqrt(P_N(2, 1)), s.age_s, s.ratio);
+  } else {
+    const Eigen::Matrix3d& P = s.P_E_m2;
+    std::snprintf(buffer, sizeof buffer,
+                  "%s %14.4f %14.4f %14.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f", time.c_str(),
+                  s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z(), static_cast<int>(s.status), s.num_satellites,
+                  std::sqrt(std::max(P(0, 0), 0.0)), std::sqrt(std::max(P(1, 1), 0.0)),
+                  std::sqrt(std::max(P(2, 2), 0.0)), signed_sqrt(P(0, 1)), signed_sqrt(P(1, 2)), signed_sqrt(P(2, 0)),
+                  s.age_s, s.ratio);
+  }
+  return buffer;
+}
+
+Status PosWriter::write(const core::Solution& solution) {
+  const std::string line = format_pos_record(solution, options_.coordinates, options_.time_format);
+  if (std::fprintf(file_.get(), "%s\n", line.c_str()) < 0) {
+    return Error{std::string("cannot write solution: ") + std::strerror(errno), path_, 0};
+  }
+  return Ok{};
+}
+
+Status PosWriter::close() {
+  if (!file_) return Ok{};
+  const bool failed = std::ferror(file_.get()) != 0;
+  std::FILE* f = file_.release();
+  if (std::fclose(f) != 0 || failed) return Error{"error writing solution file", path_, 0};
+  return Ok{};
+}
+
+Result<std::vector<core::Solution>> read_pos_file(const std::string& path) {
+  auto reader = TextReader::open(path);
+  if (!reader) return reader.error();
+  std::vector<core::Solution> out;
+  while (auto line = reader->next_line()) {
+    const std::string_view text = trim(*line);
+    if (text.empty() || text.front() == '%') continue;
+    std::istringstream in{std::string(text)};
+    core::Solution s;
+    std::string first;
+    in >> first;
+    if (first.find('/') != std::string::npos) {
+      std::string clock;
+      in >> clock;
+      core::CalendarTime c;
+      if (std::sscanf(first.c_str(), "%d/%d/%d", &c.year, &c.month, &c.day) != 3 ||
+          std::sscanf(clock.c_str(), "%d:%d:%lf", &c.hour, &c.minute, &c.second) != 3 || !core::is_valid(c)) {
+        return reader->error("bad date/time '" + first + " " + clock + "'");
+      }
+      s.time = core::calendar_to_gps(c);
+    } else {
+      const auto week = parse_int(first);
+      double tow = 0.0;
+      if (!week || !(in >> tow)) return reader->error("bad GPST week/time of week");
+      s.time = core::GpsTime{*week, tow};
+    }
+    double a = 0, b = 0, c = 0;
+    int q = 0;
+    double sd[6] = {0, 0, 0, 0, 0, 0};
+    if (!(in >> a >> b >> c >> q >> s.num_satellites)) return reader->error("bad position fields");
+    for (double& v : sd) in >> v;  // optional in some files
+    in >> s.age_s >> s.ratio;
+    s.status = static_cast<core::SolutionStatus>(q);
+    const bool llh = std::abs(a) <= 90.0 && std::abs(b) <= 360.0 && std::abs(c) < 1e5;
+    if (llh) {
+      const core::Geodetic g{a * core::kDegToRad, b * core::kDegToRad, c};
+      s.p_E_m = core::geodetic_to_ecef(g);
+      Eigen::Matrix3d P_N;
+      P_N << sd[1] * sd[1], signed_square(sd[3]), signed_square(sd[4]), signed_square(sd[3]), sd[0] * sd[0],
+          signed_square(sd[5]), signed_square(sd[4]), signed_square(sd[5]), sd[2] * sd[2];
+      const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
+      s.P_E_m2 = R_NE.transpose() * P_N * R_NE;
+    } else {
+      s.p_E_m = Eigen::Vector3d(a, b, c);
+      s.P_E_m2 << sd[0] * sd[0], signed_square(sd[3]), signed_square(sd[5]), signed_square(sd[3]), sd[1] * sd[1],
+          signed_square(sd[4]), signed_square(sd[5]), signed_square(sd[4]), sd[2] * sd[2];
+    }
+    out.push_back(s);
+  }
+  if (reader->read_error()) return reader->error(*reader->read_error());
+  return out;
+}
+
+}  // namespace canyon::io

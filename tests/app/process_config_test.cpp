@@ -1,0 +1,116 @@
+#include "canyon/app/process_config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "canyon/core/constants.hpp"
+
+namespace canyon::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+Result<ProcessConfig> parse(const std::string& text) { return parse_process_config(YAML::Load(text), "test.yaml"); }
+
+TEST(ProcessConfigTest, EveryShippedConfigLoads) {
+  const fs::path config_dir = fs::path(CANYON_SOURCE_DIR) / "config";
+  int loaded = 0;
+  for (const auto& entry : fs::directory_iterator(config_dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    const YAML::Node node = YAML::LoadFile(entry.path().string());
+    if (!node["mode"]) continue;  // not a process configuration (scenarios etc. have their own tests)
+    auto config = load_process_config(entry.path().string());
+    ASSERT_TRUE(config.ok()) << config.error().to_string();
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 2);
+}
+
+TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFile) {
+  auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/spp.yaml");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(*config, ProcessConfig{});
+}
+
+TEST(ProcessConfigTest, PrintsAndParsesBackEqual) {
+  auto config = parse(R"(
+mode: spp
+rover: /data/rover.obs
+nav: [/data/a.nav, /data/b.nav]
+out: /tmp/x.pos
+output: {coordinates: ecef, time_format: calendar}
+spp: {elevation_mask_deg: 10, systems: [G, E], ionosphere: off, raim_fde: false, exclude: [G05, E11]}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_NEAR(config->spp.elevation_mask_rad, 10.0 * core::kDegToRad, 1e-12);
+  EXPECT_FALSE(config->spp.use_glonass);
+  EXPECT_TRUE(config->spp.use_galileo);
+  EXPECT_EQ(config->spp.excluded.size(), 2U);
+  EXPECT_EQ(config->coordinates, io::PosCoordinates::Ecef);
+  auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+}
+
+TEST(ProcessConfigTest, RelativePathsAreRelativeToTheFile) {
+  auto config = parse_process_config(YAML::Load("rover: obs/r.obs\nnav: n.nav\n"), "/etc/canyon/x.yaml");
+  ASSERT_TRUE(config.ok());
+  EXPECT_EQ(config->rover_obs, "/etc/canyon/obs/r.obs");
+  EXPECT_EQ(config->nav, std::vector<std::string>{"/etc/canyon/n.nav"});
+}
+
+struct BadConfig {
+  const char* yaml;
+  const char* expected_in_message;
+  int line;
+};
+
+TEST(ProcessConfigTest, RejectsBadConfigsNamingKeyAndLine) {
+  const BadConfig cases[] = {
+      {"mode: spp\nrovr: a.obs\n", "unknown key 'rovr'", 2},
+      {"spp:\n  elevation_mask_deg: 15\n  elev_mask: 10\n", "unknown key 'spp.elev_mask'", 3},
+      {"spp:\n  elevation_mask_deg: high\n", "'spp.elevation_mask_deg' must be a number", 2},
+      {"spp:\n  systems: [G, X]\n", "'spp.systems' has 'X'", 2},
+      {"mode: ppp\n", "'mode' must be spp", 1},
+      {"output:\n  coordinates: utm\n", "'output.coordinates' must be llh or ecef", 2},
+      {"spp:\n  raim_fde: maybe\n", "'spp.raim_fde' must be true or false", 2},
+      {"spp:\n  exclude: [G99]\n", "'spp.exclude' has 'G99'", 2},
+      {"spp: 5\n", "'spp' must be a map", 1},
+      {"- a\n- b\n", "top level must be a map", 1},
+  };
+  for (const auto& c : cases) {
+    auto config = parse(c.yaml);
+    ASSERT_FALSE(config.ok()) << c.yaml;
+    EXPECT_NE(config.error().message.find(c.expected_in_message), std::string::npos)
+        << c.yaml << " -> " << config.error().message;
+    EXPECT_EQ(config.error().file, "test.yaml");
+    EXPECT_EQ(config.error().line, c.line) << c.yaml;
+  }
+}
+
+TEST(ProcessConfigTest, RejectsInvalidValues) {
+  auto config = parse("spp:\n  elevation_mask_deg: 95\n");
+  ASSERT_FALSE(config.ok());
+  EXPECT_NE(config.error().message.find("elevation_mask_rad"), std::string::npos);
+  auto none = parse("spp:\n  systems: []\n");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().message.find("at least one system"), std::string::npos);
+}
+
+TEST(ProcessConfigTest, YamlSyntaxErrorNamesTheLine) {
+  const fs::path path = fs::temp_directory_path() / "canyon_bad_syntax.yaml";
+  std::ofstream(path) << "mode: spp\nspp: {elevation_mask_deg: 10\n";
+  auto config = load_process_config(path.string());
+  ASSERT_FALSE(config.ok());
+  EXPECT_NE(config.error().message.find("YAML syntax error"), std::string::npos);
+  EXPECT_EQ(config.error().file, path.string());
+  EXPECT_GT(config.error().line, 0);
+  auto missing = load_process_config("/nonexistent/canyon.yaml");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("cannot open"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace canyon::app
