@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Times canyon's SPP (`canyon process --mode spp`) and RTKLIB's (`rnx2rtkp -p 0`) side by side on the same files
+# with the same elevation mask and constellations, in one run, and prints the ratio per dataset.
+# Whole-process wall time (start-up, reading RINEX and navigation, solving, writing .pos), median of N runs,
+# runs interleaved so that both see the same machine load.
+#
+# Usage: tests/bench/spp_vs_rtklib.sh [BUILD_DIR] [RUNS]      (defaults: build, 11)
+# Exit status: 0 if canyon is at least MIN_SPEEDUP (default 5) times faster on every dataset, else 1.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=${1:-$root/build}
+runs=${2:-11}
+min_speedup=${MIN_SPEEDUP:-5}
+data=${CANYON_SHARED_DATA_DIR:-$root/../shared/data}
+canyon=$build/canyon
+
+[[ -x $canyon ]] || { echo "error: $canyon not built (run scripts/build.sh)" >&2; exit 2; }
+command -v rnx2rtkp >/dev/null || { echo "error: rnx2rtkp not installed (run scripts/setup.sh)" >&2; exit 2; }
+[[ -d $data ]] || { echo "skipped: shared datasets not found at $data" >&2; exit 0; }
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+# name | systems | rover | nav files...
+datasets=(
+  "rtklib-test-gsi-2005|G|rtklib-test-gsi-2005/07590920.05o|rtklib-test-gsi-2005/07590920.05n"
+  "cssrlib-static-doy078|G,E,J|cssrlib-static-doy078/SEPT078M1.21O|cssrlib-static-doy078/SEPT078M.21P"
+  "cssrlib-kinematic-doy265|G,E,J|cssrlib-kinematic-doy265/SEPT265G.21O|cssrlib-kinematic-doy265/SEPT2650.21P"
+  "matrtklib-static|G,R,E,C,J|matrtklib-static/rover.obs|matrtklib-static/base.nav"
+  "m8p-galway-20181004|G,R,J|m8p-galway-20181004/rinex/20181004_rover-20181004-1532.obs|m8p-galway-20181004/rinex/20181004_rover-20181004-1532.nav"
+  "instinct-spirent-rtk-sim|G,E|instinct-spirent-rtk-sim/iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs|instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N|instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"
+)
+
+# Seconds (float) a command takes.
+elapsed() {
+  local start end
+  start=$(date +%s%N)
+  "$@" >/dev/null 2>&1
+  end=$(date +%s%N)
+  echo $(((end - start) / 1000))  # microseconds
+}
+
+median() { sort -n | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
+
+printf '%-26s %7s %12s %12s %9s\n' dataset epochs "canyon ms" "RTKLIB ms" speedup
+status=0
+for entry in "${datasets[@]}"; do
+  IFS='|' read -r name systems rover navs <<<"$entry"
+  IFS='|' read -r -a nav_files <<<"$navs"
+  [[ -f $data/$rover ]] || { echo "$name: missing, skipped"; continue; }
+  letters=${systems//,/, }
+  cat >"$tmp/$name.yaml" <<YAML
+mode: spp
+spp:
+  systems: [$letters]
+  elevation_mask_deg: 15
+YAML
+  canyon_args=(process -q --config "$tmp/$name.yaml" --rover "$data/$rover" --out "$tmp/canyon.pos")
+  rtklib_args=(-p 0 -m 15 -sys "$systems" -o "$tmp/rtklib.pos" "$data/$rover")
+  for n in "${nav_files[@]}"; do
+    canyon_args+=(--nav "$data/$n")
+    rtklib_args+=("$data/$n")
+  done
+  : >"$tmp/c" ; : >"$tmp/r"
+  for ((i = 0; i < runs; i++)); do
+    elapsed "$canyon" "${canyon_args[@]}" >>"$tmp/c"
+    elapsed rnx2rtkp "${rtklib_args[@]}" >>"$tmp/r"
+  done
+  c=$(median <"$tmp/c")
+  r=$(median <"$tmp/r")
+  epochs=$(grep -vc '^%' "$tmp/canyon.pos" || true)
+  speedup=$(awk -v c="$c" -v r="$r" 'BEGIN {printf "%.1f", r / c}')
+  printf '%-26s %7d %12.1f %12.1f %8sx\n' "$name" "$epochs" "$(awk -v c="$c" 'BEGIN{print c/1000}')" \
+    "$(awk -v r="$r" 'BEGIN{print r/1000}')" "$speedup"
+  awk -v s="$speedup" -v m="$min_speedup" 'BEGIN {exit !(s >= m)}' || status=1
+done
+[[ $status -eq 0 ]] && echo "canyon SPP is at least ${min_speedup}x faster than rnx2rtkp -p 0 on every dataset" ||
+  echo "canyon SPP is NOT ${min_speedup}x faster than rnx2rtkp -p 0 on every dataset"
+exit $status
