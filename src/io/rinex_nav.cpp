@@ -267,7 +267,19 @@ class NavParser {
     return add_kepler(*sat, epoch, v, record_line);
   }
 
+  /// Integer-valued fields (IODE, health, codes, week, ...) must fit an int before they are converted.
+  Status check_integers(const std::vector<double>& v, std::initializer_list<std::size_t> indices, int line) const {
+    for (const std::size_t i : indices) {
+      if (!(std::abs(v[i]) < 1e9)) {
+        return Error{"integer field " + std::to_string(i + 1) + " out of range", reader_.path(), line};
+      }
+    }
+    return Ok{};
+  }
+
   Status add_kepler(core::SatelliteId sat, const CalendarTime& epoch, const std::vector<double>& v, int line) {
+    Status ints = check_integers(v, {3, 20, 21, 24, 26, 28}, line);
+    if (!ints.ok()) return ints;
     core::KeplerEphemeris e;
     e.sat = sat;
     const bool bds = sat.system == Constellation::BeiDou;
@@ -326,6 +338,8 @@ class NavParser {
   }
 
   Status add_glonass(core::SatelliteId sat, const CalendarTime& epoch_utc, const std::vector<double>& v, int line) {
+    Status ints = check_integers(v, {6, 10, 14}, line);
+    if (!ints.ok()) return ints;
     core::GlonassEphemeris g;
     g.sat = sat;
     const int leap = out_.nav.leap_seconds.value_or(leaps_.gps_minus_utc_at_utc(epoch_utc));
