@@ -63,7 +63,9 @@ struct GlonassEphemeris {
   Eigen::Vector3d p_E_m = Eigen::Vector3d::Zero();     ///< position, PZ-90 (m)
   Eigen::Vector3d v_E_mps = Eigen::Vector3d::Zero();   ///< velocity (m/s)
   Eigen::Vector3d a_E_mps2 = Eigen::Vector3d::Zero();  ///< lunisolar acceleration (m/s^2)
-  double tau_n_s = 0.0;  ///< -tau_n: satellite clock = -tau_n + gamma_n (t - tb) as RINEX gives "SV clock bias"
+  /// MINUS tau_n (s), i.e. RINEX's "SV clock bias" as written: satellite clock = tau_n_s + gamma_n (t - tb)
+  /// (= -tau_n + gamma_n (t - tb) in ICD terms). Decoders of the raw message (RTCM 1020, UBX) store -tau_n here.
+  double tau_n_s = 0.0;
   double gamma_n = 0.0;  ///< relative frequency bias
   double delta_tau_n_s = 0.0;
 };

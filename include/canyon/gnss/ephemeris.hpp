@@ -5,7 +5,15 @@
 // integration of the PZ-90 state with J2 and the broadcast lunisolar acceleration. Positions are in the ECEF frame
 // at the instant of transmission (the Earth-rotation correction during signal flight depends on the receiver and is
 // applied by geometric_range_m()). Clock bias includes the relativistic eccentricity correction and excludes group
-// delays (see group_delay_s()).
+// delays (see group_delay_s()). Kepler velocity and clock drift are central differences (+-1 ms) of the analytic
+// position and clock; GLONASS velocity is the integrated state and its drift gamma_n.
+//
+// Selection (select_kepler/select_glonass): usable health (or options.use_unhealthy), |t - toe| within the maximum
+// age, nearest toe; on a tie, the latest transmitted record. Galileo additionally: I/NAV records (data source bit 0
+// or 9) are preferred to F/NAV whenever one is usable, and only records whose toe has passed (toe < t) are used --
+// the rule RTKLIB 2.4.3 applies, matched so that canyon and RTKLIB pick the same record (tests/gnss/
+// ephemeris_reference_test.cpp); a Galileo toe marks the start of a record's use, so a future toe is a record not
+// broadcast yet.
 
 #include <optional>
 #include <vector>
@@ -22,9 +30,9 @@ struct SatelliteState {
   core::SatelliteId sat;
   Eigen::Vector3d p_E_m = Eigen::Vector3d::Zero();    ///< ECEF at transmission time
   Eigen::Vector3d v_E_mps = Eigen::Vector3d::Zero();  ///< ECEF velocity (rotating frame)
-  double clock_bias_s = 0.0;       ///< satellite clock minus system time, relativity included, no group delay
+  double clock_bias_s = 0.0;  ///< satellite clock minus system time, relativity included, no group delay
   double clock_drift_sps = 0.0;
-  double variance_m2 = 0.0;        ///< ephemeris/clock error variance from URA/SISA
+  double variance_m2 = 0.0;  ///< ephemeris/clock error variance from URA/SISA
   int iode = 0;
   int glonass_channel = core::kNoGlonassChannel;
 };
@@ -42,8 +50,7 @@ class EphemerisStore {
  public:
   explicit EphemerisStore(core::NavigationData nav, EphemerisOptions options = {});
 
-  /// The ephemeris to use for `sat` at GPST `t`: healthy, within its validity, nearest toe (Galileo: I/NAV
-  /// preferred). nullptr if none.
+  /// The ephemeris to use for `sat` at GPST `t` (rules in the file comment). nullptr if none.
   [[nodiscard]] const core::KeplerEphemeris* select_kepler(core::SatelliteId sat, core::GpsTime t) const;
   [[nodiscard]] const core::GlonassEphemeris* select_glonass(core::SatelliteId sat, core::GpsTime t) const;
 
@@ -75,7 +82,9 @@ class EphemerisStore {
 };
 
 /// Geometric range (m) from a receiver at p_E_rcv to a satellite at p_E_sat (ECEF at transmission time), with the
-/// Earth-rotation (Sagnac) correction for the signal's flight. Writes the unit line of sight rcv -> sat if asked.
+/// Earth-rotation (Sagnac) correction for the signal's flight: the first-order term omega_e (x_s y_r - y_s x_r) / c of
+/// rotating the satellite by omega_e * range / c about Z (remainder < 1 mm). Writes the unit line of sight rcv -> sat
+/// if asked.
 [[nodiscard]] double geometric_range_m(const Eigen::Vector3d& p_E_sat, const Eigen::Vector3d& p_E_rcv,
                                        Eigen::Vector3d* los_E = nullptr);
 

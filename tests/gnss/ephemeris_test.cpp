@@ -1,0 +1,257 @@
+// Ephemeris store unit tests: velocity and clock drift against numeric derivatives, GLONASS integration forward and
+// back, BeiDou GEO and GPS orbit sanity, selection rules, transmission-time iteration, group delays, Sagnac range.
+
+#include "canyon/gnss/ephemeris.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "canyon/core/constants.hpp"
+
+namespace canyon::gnss {
+namespace {
+
+using core::Constellation;
+using core::GpsTime;
+
+constexpr double kMaxVelErrorMps = 1e-3;
+
+// Values from the matrtklib-static navigation file (G05, C01 GEO, R01), typed in.
+core::KeplerEphemeris gps_g05() {
+  core::KeplerEphemeris e;
+  e.sat = {Constellation::Gps, 5};
+  e.toc = {2320, 122400.0};
+  e.toe = {2320, 122400.0};
+  e.transmission_time = {2320, 115218.0};
+  e.af0_s = -1.774230040610E-04;
+  e.af1_sps = -1.364242052659E-12;
+  e.iode = 72;
+  e.crs_m = -9.821875000000E+01;
+  e.delta_n_radps = 4.293035965037E-09;
+  e.m0_rad = 1.714815412488E+00;
+  e.cuc_rad = -5.291774868965E-06;
+  e.e = 5.927642923780E-03;
+  e.cus_rad = 1.830980181694E-06;
+  e.sqrt_a_sqrtm = 5.153635631561E+03;
+  e.toe_sow_s = 1.224000000000E+05;
+  e.cic_rad = 3.352761268616E-08;
+  e.omega0_rad = 2.520897825810E+00;
+  e.cis_rad = -5.774199962616E-08;
+  e.i0_rad = 9.719266524177E-01;
+  e.crc_m = 3.536250000000E+02;
+  e.omega_rad = 1.273307347665E+00;
+  e.omega_dot_radps = -8.275344701323E-09;
+  e.idot_radps = -2.610823036973E-10;
+  e.accuracy_m = 2.0;
+  e.tgd_s = {-1.071020960808E-08, 0.0};
+  return e;
+}
+
+core::KeplerEphemeris bds_c01_geo() {
+  core::KeplerEphemeris e;
+  e.sat = {Constellation::BeiDou, 1};
+  e.toc = {2320, 86400.0 + 28814.0};
+  e.toe = {2320, 115214.0};
+  e.transmission_time = e.toe;
+  e.af0_s = 9.039411088452E-04;
+  e.af1_sps = 2.186695269302E-12;
+  e.iode = 1;
+  e.crs_m = 3.987812500000E+02;
+  e.delta_n_radps = 1.168655822063E-08;
+  e.m0_rad = -7.785119710056E-01;
+  e.cuc_rad = 1.305714249611E-05;
+  e.e = 2.352053998038E-04;
+  e.cus_rad = -1.721968874335E-05;
+  e.sqrt_a_sqrtm = 6.493358730316E+03;
+  e.toe_sow_s = 1.152000000000E+05;
+  e.cic_rad = 3.771856427193E-08;
+  e.omega0_rad = -1.376223151778E+00;
+  e.cis_rad = -3.306195139885E-08;
+  e.i0_rad = 6.493194956776E-02;
+  e.crc_m = 5.192812500000E+02;
+  e.omega_rad = 5.103894865136E-01;
+  e.omega_dot_radps = -1.047865076358E-08;
+  e.idot_radps = 2.235807416067E-10;
+  e.accuracy_m = 2.0;
+  e.tgd_s = {-4.9e-9, -1.0e-8};
+  return e;
+}
+
+core::GlonassEphemeris glonass_r01() {
+  core::GlonassEphemeris g;
+  g.sat = {Constellation::Glonass, 1};
+  g.toe = {2320, 86400.0 + 8 * 3600 + 15 * 60 + 18};
+  g.frame_time = {2320, 115218.0};
+  g.frequency_channel = 1;
+  g.p_E_m = Eigen::Vector3d(-1.373688769531E+04, -3.309238281250E+03, 2.124241259766E+04) * 1e3;
+  g.v_E_mps = Eigen::Vector3d(-1.554378509521E+00, -2.458472251892E+00, -1.386628150940E+00) * 1e3;
+  g.a_E_mps2 = Eigen::Vector3d(9.313225746155E-10, 1.862645149231E-09, -1.862645149231E-09) * 1e3;
+  g.tau_n_s = 8.934084326029E-05;
+  g.gamma_n = 9.094947017729E-13;
+  return g;
+}
+
+EphemerisStore store_of(std::vector<core::KeplerEphemeris> kepler, std::vector<core::GlonassEphemeris> glo = {},
+                        EphemerisOptions options = {}) {
+  core::NavigationData nav;
+  nav.kepler = std::move(kepler);
+  nav.glonass = std::move(glo);
+  return EphemerisStore(std::move(nav), options);
+}
+
+void expect_velocity_is_derivative(const EphemerisStore& store, core::SatelliteId sat, GpsTime t) {
+  const double h_s = 0.5;
+  const auto s = store.state(sat, t), before = store.state(sat, t - h_s), after = store.state(sat, t + h_s);
+  ASSERT_TRUE(s && before && after);
+  const Eigen::Vector3d v_num = (after->p_E_m - before->p_E_m) / (2.0 * h_s);
+  EXPECT_LT((s->v_E_mps - v_num).norm(), kMaxVelErrorMps) << sat.to_string();
+  const double drift_num = (after->clock_bias_s - before->clock_bias_s) / (2.0 * h_s);
+  EXPECT_NEAR(s->clock_drift_sps, drift_num, 1e-14) << sat.to_string();
+}
+
+TEST(Ephemeris, VelocityAndDriftAreDerivatives) {
+  const EphemerisStore store = store_of({gps_g05(), bds_c01_geo()}, {glonass_r01()});
+  for (const double dt_s : {-3000.0, -100.0, 0.0, 1234.5, 3600.0}) {
+    expect_velocity_is_derivative(store, {Constellation::Gps, 5}, GpsTime{2320, 122400.0} + dt_s);
+    expect_velocity_is_derivative(store, {Constellation::BeiDou, 1}, GpsTime{2320, 115214.0} + dt_s);
+  }
+  for (const double dt_s : {-1700.0, -45.0, 0.0, 30.0, 900.0, 1700.0}) {
+    expect_velocity_is_derivative(store, {Constellation::Glonass, 1}, glonass_r01().toe + dt_s);
+  }
+}
+
+TEST(Ephemeris, OrbitRadii) {
+  const EphemerisStore store = store_of({gps_g05(), bds_c01_geo()});
+  const auto g = store.state({Constellation::Gps, 5}, {2320, 123000.0});
+  ASSERT_TRUE(g);
+  EXPECT_NEAR(g->p_E_m.norm(), 26.56e6, 0.2e6);
+  EXPECT_NEAR(g->v_E_mps.norm(), 3.0e3, 1.0e3);  // ECEF speed of a GPS satellite
+  const auto c = store.state({Constellation::BeiDou, 1}, {2320, 116000.0});
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->p_E_m.norm(), 42.16e6, 0.05e6);
+  EXPECT_LT(c->v_E_mps.norm(), 300.0);                // geostationary, inclined 3.7 deg: slow figure-eight in ECEF
+  EXPECT_LT(std::abs(c->p_E_m.z()), 0.05 * 42.16e6);  // near the equator
+}
+
+TEST(Ephemeris, GlonassForwardAndBackAgree) {
+  const core::GlonassEphemeris g = glonass_r01();
+  const EphemerisStore store = store_of({}, {g});
+  const double dt_s = 1500.0;
+  const auto forward = store.state(g.sat, g.toe + dt_s);
+  ASSERT_TRUE(forward);
+  core::GlonassEphemeris moved = g;
+  moved.toe = g.toe + dt_s;
+  moved.p_E_m = forward->p_E_m;
+  moved.v_E_mps = forward->v_E_mps;
+  const EphemerisStore back_store = store_of({}, {moved});
+  const auto back = back_store.state(g.sat, g.toe);
+  ASSERT_TRUE(back);
+  EXPECT_LT((back->p_E_m - g.p_E_m).norm(), 1e-3);
+  EXPECT_LT((back->v_E_mps - g.v_E_mps).norm(), 1e-6);
+  // Clock: RINEX stores -tau_n; clock = -tau_n + gamma_n (t - tb).
+  EXPECT_DOUBLE_EQ(forward->clock_bias_s, g.tau_n_s + g.gamma_n * dt_s);
+  EXPECT_EQ(forward->glonass_channel, 1);
+}
+
+TEST(Ephemeris, KeplerClockIncludesRelativity) {
+  const core::KeplerEphemeris e = gps_g05();
+  const EphemerisStore store = store_of({e});
+  const GpsTime t = e.toc + 600.0;
+  const auto s = store.state(e.sat, t);
+  ASSERT_TRUE(s);
+  const double poly_s = e.af0_s + e.af1_sps * 600.0;
+  // |relativistic term| <= 2 sqrt(mu a) e / c^2 = 4.44e-10 e sqrt(a) ~ 13.5 ns for e = 0.0059.
+  const double bound_s = 4.4428e-10 * e.e * e.sqrt_a_sqrtm;
+  EXPECT_LE(std::abs(s->clock_bias_s - poly_s), bound_s * 1.001);
+  EXPECT_GT(std::abs(s->clock_bias_s - poly_s), 0.0);
+  EXPECT_DOUBLE_EQ(s->variance_m2, 4.0);
+}
+
+TEST(Ephemeris, SelectionRules) {
+  core::KeplerEphemeris a = gps_g05(), b = gps_g05(), sick = gps_g05();
+  a.toe = a.toc = {2320, 115200.0};
+  a.iode = 10;
+  b.toe = b.toc = {2320, 122400.0};
+  b.iode = 11;
+  sick.toe = sick.toc = {2320, 118800.0};
+  sick.health = 1;
+  sick.iode = 12;
+  const EphemerisStore store = store_of({a, b, sick});
+  EXPECT_EQ(store.select_kepler(a.sat, {2320, 118000.0})->iode, 10);  // nearest healthy toe
+  EXPECT_EQ(store.select_kepler(a.sat, {2320, 119000.0})->iode, 11);
+  EXPECT_EQ(store.select_kepler(a.sat, {2320, 122400.0 + 5 * 3600.0}), nullptr);  // too old
+  EXPECT_EQ(store.select_kepler({Constellation::Gps, 6}, {2320, 118000.0}), nullptr);
+  EphemerisOptions unhealthy;
+  unhealthy.use_unhealthy = true;
+  const EphemerisStore store2 = store_of({a, b, sick}, {}, unhealthy);
+  EXPECT_EQ(store2.select_kepler(a.sat, {2320, 118800.0})->iode, 12);
+
+  // Galileo: I/NAV preferred over F/NAV with the same toe; a toe not yet reached is not used.
+  core::KeplerEphemeris inav = gps_g05(), fnav = gps_g05(), next = gps_g05();
+  for (auto* e : {&inav, &fnav, &next}) e->sat = {Constellation::Galileo, 4};
+  inav.data_source = 517;
+  inav.iode = 1;
+  fnav.data_source = 258;
+  fnav.iode = 2;
+  next.data_source = 517;
+  next.iode = 3;
+  next.toe = next.toc = inav.toe + 600.0;
+  const EphemerisStore gal = store_of({fnav, inav, next});
+  EXPECT_EQ(gal.select_kepler(inav.sat, inav.toe + 300.0)->iode, 1);
+  EXPECT_EQ(gal.select_kepler(inav.sat, inav.toe + 599.0)->iode, 1);
+  EXPECT_EQ(gal.select_kepler(inav.sat, inav.toe + 601.0)->iode, 3);
+  const EphemerisStore fnav_only = store_of({fnav});
+  EXPECT_EQ(fnav_only.select_kepler(inav.sat, inav.toe + 300.0)->iode, 2);
+}
+
+TEST(Ephemeris, StateAtReceptionSolvesLightTime) {
+  const EphemerisStore store = store_of({gps_g05()});
+  const GpsTime t_rx{2320, 123000.0};
+  const double pseudorange_m = 22.0e6;
+  GpsTime t_tx;
+  const auto s = store.state_at_reception({Constellation::Gps, 5}, t_rx, pseudorange_m, &t_tx);
+  ASSERT_TRUE(s);
+  EXPECT_NEAR((t_rx - t_tx) - pseudorange_m / core::kSpeedOfLightMps - s->clock_bias_s, 0.0,
+              1e-10);  // tow resolution ~3e-11 s
+}
+
+TEST(Ephemeris, GroupDelays) {
+  core::KeplerEphemeris gal = gps_g05();
+  gal.sat = {Constellation::Galileo, 4};
+  gal.data_source = 517;
+  gal.tgd_s = {-1.6e-9, -2.3e-9};
+  const EphemerisStore store = store_of({gps_g05(), bds_c01_geo(), gal});
+  const GpsTime t{2320, 123000.0};  // after every toe (Galileo needs toe < t)
+  const double tgd = gps_g05().tgd_s[0];
+  EXPECT_DOUBLE_EQ(store.group_delay_s({Constellation::Gps, 5}, {'1', 'C'}, t), tgd);
+  EXPECT_NEAR(store.group_delay_s({Constellation::Gps, 5}, {'2', 'W'}, t), tgd * std::pow(77.0 / 60.0, 2), 1e-20);
+  EXPECT_DOUBLE_EQ(store.group_delay_s({Constellation::BeiDou, 1}, {'2', 'I'}, t), -4.9e-9);
+  EXPECT_DOUBLE_EQ(store.group_delay_s({Constellation::BeiDou, 1}, {'7', 'I'}, t), -1.0e-8);
+  EXPECT_DOUBLE_EQ(store.group_delay_s({Constellation::BeiDou, 1}, {'6', 'I'}, t), 0.0);
+  EXPECT_DOUBLE_EQ(store.group_delay_s(gal.sat, {'1', 'C'}, t), -2.3e-9);  // I/NAV: BGD(E1,E5b)
+  EXPECT_NEAR(store.group_delay_s(gal.sat, {'7', 'Q'}, t), -2.3e-9 * std::pow(1575.42 / 1207.14, 2), 1e-20);
+  EXPECT_DOUBLE_EQ(store.group_delay_s({Constellation::Gps, 9}, {'1', 'C'}, t), 0.0);
+}
+
+TEST(Ephemeris, SagnacMatchesExactRotation) {
+  const Eigen::Vector3d p_sat(15.0e6, 20.0e6, 8.0e6), p_rcv(-3.96e6, 3.38e6, 3.67e6);
+  Eigen::Vector3d los;
+  const double range_m = geometric_range_m(p_sat, p_rcv, &los);
+  // Exact: rotate the satellite by -omega_e tau (the Earth turned during the flight), iterate on tau.
+  double tau_s = (p_sat - p_rcv).norm() / core::kSpeedOfLightMps;
+  double exact_m = 0.0;
+  for (int i = 0; i < 5; ++i) {
+    const double a = core::kEarthRotationRateRadps * tau_s;
+    const Eigen::Vector3d p_rot(std::cos(a) * p_sat.x() + std::sin(a) * p_sat.y(),
+                                -std::sin(a) * p_sat.x() + std::cos(a) * p_sat.y(), p_sat.z());
+    exact_m = (p_rot - p_rcv).norm();
+    tau_s = exact_m / core::kSpeedOfLightMps;
+  }
+  EXPECT_NEAR(range_m, exact_m, 1e-3);
+  EXPECT_GT(std::abs(range_m - (p_sat - p_rcv).norm()), 1.0);  // the correction is tens of metres here
+  EXPECT_NEAR(los.norm(), 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace canyon::gnss
