@@ -256,6 +256,7 @@ Status RinexObsReader::read_version_line() {
 }
 
 Status RinexObsReader::read_header() {
+  header_.time_system.clear();  // set by TIME OF FIRST OBS, else from the file's system in finish_header()
   if (Status s = read_version_line(); !s.ok()) return s;
   for (;;) {
     const auto next = reader_.next_line();
@@ -460,7 +461,7 @@ Status RinexObsReader::finish_header() {
     }
   }
   // Time system of the epochs: TIME OF FIRST OBS says it, else the file's single system does.
-  if (!first_obs_calendar_ || trim(header_.time_system).empty()) {
+  if (header_.time_system.empty()) {
     switch (header_.file_system) {
       case 'R': header_.time_system = "GLO"; break;
       case 'E': header_.time_system = "GAL"; break;
