@@ -183,6 +183,7 @@ struct RinexObsReader::Mapping {
   struct Column {
     std::int8_t signal = -1;  // index into `signals`, -1 for a column canyon ignores
     ObsKind kind = ObsKind::None;
+    double scale = 1.0;  // "SYS / SCALE FACTOR": the file holds value * scale
   };
   struct System {
     bool declared = false;
@@ -325,7 +326,7 @@ Status RinexObsReader::parse_header_record(std::string_view line, std::string_vi
   } else if (label == "SYS / PHASE SHIFT" || label == "SYS / PHASE SHIFTS") {
     parse_phase_shift(line);
   } else if (label == "SYS / SCALE FACTOR") {
-    warn(reader_.line_number(), "SYS / SCALE FACTOR is not supported: observations are read unscaled");
+    return parse_scale_factor(line);
   }
   return Ok{};
 }
@@ -435,6 +436,34 @@ void RinexObsReader::parse_phase_shift(std::string_view line) {
   header_.receiver.phase_shifts.push_back({*system, *signal, *shift});
 }
 
+Status RinexObsReader::parse_scale_factor(std::string_view line) {
+  const std::string_view system_field = column(line, 0, 1);
+  if (!system_field.empty() && system_field[0] != ' ') {
+    const auto factor = parse_int(column(line, 2, 4));
+    if (!factor || (*factor != 1 && *factor != 10 && *factor != 100 && *factor != 1000)) {
+      return reader_.error("bad SYS / SCALE FACTOR '" + std::string(trim(column(line, 2, 4))) +
+                           "' (1, 10, 100 or 1000)");
+    }
+    continued_scale_ = {system_field[0], "", static_cast<double>(*factor)};
+    const auto count = parse_int(column(line, 8, 2), 0);
+    if (!count || *count == 0) {  // no list: every type of the system
+      scale_factors_.push_back(continued_scale_);
+      return Ok{};
+    }
+  } else if (continued_scale_.system == 0) {
+    return reader_.error("SYS / SCALE FACTOR continuation line without a system");
+  }
+  const auto system = core::constellation_from_letter(continued_scale_.system);
+  for (std::size_t k = 0; k < 12; ++k) {
+    const std::string_view code = trim(column(line, 11 + 4 * k, 3));
+    if (code.empty()) continue;
+    ScaleFactor f = continued_scale_;
+    f.code = system ? remap_code(*system, std::string(code), version_code_) : std::string(code);
+    scale_factors_.push_back(f);
+  }
+  return Ok{};
+}
+
 core::GpsTime RinexObsReader::to_gps(const core::CalendarTime& c) const {
   const std::string& ts = header_.time_system;
   if (ts == "GLO") return core::glonass_to_gps(c, leaps_);
@@ -500,7 +529,11 @@ void RinexObsReader::build_mapping() {
       if (kind == ObsKind::None || !signal) continue;  // e.g. Septentrio's "X1" channel numbers
       auto it = std::find(m.signals.begin(), m.signals.end(), *signal);
       if (it == m.signals.end()) it = m.signals.insert(m.signals.end(), *signal);
-      m.columns[k] = {static_cast<std::int8_t>(it - m.signals.begin()), kind};
+      double scale = 1.0;
+      for (const ScaleFactor& f : scale_factors_) {
+        if (f.system == core::system_letter(system) && (f.code.empty() || f.code == code)) scale = f.factor;
+      }
+      m.columns[k] = {static_cast<std::int8_t>(it - m.signals.begin()), kind, scale};
     }
     mapping->max_signals = std::max(mapping->max_signals, m.signals.size());
   }
@@ -596,17 +629,19 @@ Status RinexObsReader::parse_fields(std::string_view line, std::size_t first_col
     }
     const std::size_t k = first_field + i;
     if (*value == 0.0 || k >= m.columns.size() || m.columns[k].signal < 0) continue;
-    core::SignalObs& s = scratch_[static_cast<std::size_t>(m.columns[k].signal)];
-    switch (m.columns[k].kind) {
-      case ObsKind::Pseudorange: s.pseudorange_m = *value; break;
+    const Mapping::Column& c = m.columns[k];
+    const double v = c.scale == 1.0 ? *value : *value / c.scale;
+    core::SignalObs& s = scratch_[static_cast<std::size_t>(c.signal)];
+    switch (c.kind) {
+      case ObsKind::Pseudorange: s.pseudorange_m = v; break;
       case ObsKind::Phase: {
-        s.carrier_phase_cyc = *value;
+        s.carrier_phase_cyc = v;
         const char lli = pos + kValueWidth < line.size() ? line[pos + kValueWidth] : ' ';
         s.lli = (lli >= '0' && lli <= '9') ? static_cast<std::uint8_t>(lli - '0') : 0;
         break;
       }
-      case ObsKind::Doppler: s.doppler_hz = *value; break;
-      case ObsKind::Snr: s.snr_dbhz = *value; break;
+      case ObsKind::Doppler: s.doppler_hz = v; break;
+      case ObsKind::Snr: s.snr_dbhz = v; break;
       case ObsKind::None: break;
     }
   }

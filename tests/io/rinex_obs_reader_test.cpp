@@ -229,6 +229,29 @@ TEST(RinexObservationReader, OtherSystemsAreSkippedWithOneWarningEach) {
   EXPECT_EQ(file.header.obs_types.size(), 1u);
 }
 
+TEST(RinexObservationReader, ScaleFactorsDivideTheValues) {
+  test::TempDir tmp;
+  // L1C and D1C scaled by 10 (listed on a continuation line), every GLONASS type by 100.
+  const std::string text =
+      version_line("     3.04") + header_line("G    4 C1C L1C D1C S1C", "SYS / # / OBS TYPES") +
+      header_line("R    2 C1C L1C", "SYS / # / OBS TYPES") + header_line("G   10  2", "SYS / SCALE FACTOR") +
+      header_line("           L1C D1C", "SYS / SCALE FACTOR") + header_line("R  100", "SYS / SCALE FACTOR") +
+      header_line("", "END OF HEADER") + epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 2) +
+      record_v3("G05", 21000000.0, 1100000000.5) + "R01" + obs_field(2100000000.0) + obs_field(950000000.0) + "\n";
+  const RinexObsFile file = read_ok(tmp.write("scaled.rnx", text));
+  ASSERT_EQ(file.epochs.size(), 1u);
+  const auto* g = find_signal(file.epochs[0], {Constellation::Gps, 5}, {'1', 'C'});
+  ASSERT_NE(g, nullptr);
+  EXPECT_DOUBLE_EQ(g->pseudorange_m, 21000000.0);
+  EXPECT_DOUBLE_EQ(g->carrier_phase_cyc, 110000000.05);
+  EXPECT_DOUBLE_EQ(g->doppler_hz, -123.45);
+  EXPECT_DOUBLE_EQ(g->snr_dbhz, 45.25);
+  const auto* r = find_signal(file.epochs[0], {Constellation::Glonass, 1}, {'1', 'C'});
+  ASSERT_NE(r, nullptr);
+  EXPECT_DOUBLE_EQ(r->pseudorange_m, 21000000.0);
+  EXPECT_DOUBLE_EQ(r->carrier_phase_cyc, 9500000.0);
+}
+
 TEST(RinexObservationReader, MissingValuesAreNanAndEmptySignalsDropped) {
   test::TempDir tmp;
   const std::string text = header_v3() + epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 2) + "G05" + obs_field(21000000.0) +

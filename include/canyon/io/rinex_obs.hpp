@@ -19,7 +19,7 @@
 //
 // Observation values of 0.0 or blank are missing (NaN). The LLI of the carrier phase is kept; the signal strength
 // indicator digits are not read (the S observable gives the SNR). Each SatelliteObs holds only the signals that
-// have at least one observable. "SYS / SCALE FACTOR" is not applied (no known receiver writes it).
+// have at least one observable. "SYS / SCALE FACTOR" divisors are applied on reading.
 
 #include <map>
 #include <memory>
@@ -72,6 +72,7 @@ class RinexObsReader {
   Status parse_time_of_first_obs(std::string_view line);
   Status parse_glonass_slots(std::string_view line);
   void parse_phase_shift(std::string_view line);
+  Status parse_scale_factor(std::string_view line);
   Status finish_header();
   void build_mapping();
   /// Reads the `count` header records following an event epoch line (flags 2-5).
@@ -110,6 +111,13 @@ class RinexObsReader {
   std::vector<core::SignalObs> scratch_;                  // per-signal accumulator of one satellite record
   std::string warned_systems_;                            // system letters already warned about
   std::vector<std::string> warned_satellites_;
+  struct ScaleFactor {
+    char system = 0;
+    std::string code;  // empty: all types of the system
+    double factor = 1.0;
+  };
+  std::vector<ScaleFactor> scale_factors_;  // "SYS / SCALE FACTOR"
+  ScaleFactor continued_scale_;             // system and factor a continuation line refers to
 };
 
 /// A whole file in memory.
