@@ -1,12 +1,12 @@
 #include "canyon/io/text_reader.hpp"
 
-#include <zlib.h>
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+
+#include <zlib.h>
 
 namespace canyon::io {
 

@@ -1,0 +1,76 @@
+#pragma once
+// Helpers for the RINEX tests: a per-test temporary folder and builders for fixed-column RINEX text.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+namespace canyon::io::test {
+
+/// Fresh folder under the system temp dir, named after the running test, removed at destruction.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ =
+        std::filesystem::temp_directory_path() / ("canyon_io_" + std::string(info->test_suite_name()) + "_" +
+                                                  info->name() + "_" + std::to_string(static_cast<long>(::getpid())));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    if (!::testing::Test::HasFailure()) std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  [[nodiscard]] std::string file(const std::string& name) const { return (path_ / name).string(); }
+  /// Writes `content` to a file in the folder and returns its path.
+  [[nodiscard]] std::string write(const std::string& name, std::string_view content) const {
+    const std::string p = file(name);
+    std::ofstream(p, std::ios::binary) << content;
+    return p;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// A header line: content padded to 60 columns, then the label.
+inline std::string header_line(std::string content, std::string_view label) {
+  content.resize(60, ' ');
+  return content + std::string(label) + "\n";
+}
+
+/// One F14.3 observation field with LLI and SSI digits (blank when negative); a blank field for NaN.
+inline std::string obs_field(double value, int lli = -1, int ssi = -1) {
+  if (value != value) return std::string(16, ' ');
+  char text[32];
+  std::snprintf(text, sizeof text, "%14.3f%c%c", value, lli < 0 ? ' ' : static_cast<char>('0' + lli),
+                ssi < 0 ? ' ' : static_cast<char>('0' + ssi));
+  return text;
+}
+
+/// RINEX 3 epoch line.
+inline std::string epoch_v3(int year, int month, int day, int hour, int minute, double second, int flag, int count) {
+  char text[64];
+  std::snprintf(text, sizeof text, "> %04d %02d %02d %02d %02d%11.7f  %d%3d\n", year, month, day, hour, minute, second,
+                flag, count);
+  return text;
+}
+
+/// RINEX 2 epoch line without the satellite list and newline.
+inline std::string epoch_v2(int year, int month, int day, int hour, int minute, double second, int flag, int count) {
+  char text[64];
+  std::snprintf(text, sizeof text, " %02d %2d %2d %2d %2d%11.7f  %d%3d", year % 100, month, day, hour, minute, second,
+                flag, count);
+  return text;
+}
+
+}  // namespace canyon::io::test
