@@ -36,12 +36,18 @@ void parse_spp(YamlMap map, gnss::SppOptions& o) {
   map.get("systems", systems);
   o.use_gps = o.use_glonass = o.use_galileo = o.use_beidou = o.use_qzss = false;
   for (const std::string& s : systems) {
-    if (s == "G") o.use_gps = true;
-    else if (s == "R") o.use_glonass = true;
-    else if (s == "E") o.use_galileo = true;
-    else if (s == "C") o.use_beidou = true;
-    else if (s == "J") o.use_qzss = true;
-    else map.fail("systems", "has '" + s + "'; allowed: G, R, E, C, J");
+    if (s == "G")
+      o.use_gps = true;
+    else if (s == "R")
+      o.use_glonass = true;
+    else if (s == "E")
+      o.use_galileo = true;
+    else if (s == "C")
+      o.use_beidou = true;
+    else if (s == "J")
+      o.use_qzss = true;
+    else
+      map.fail("systems", "has '" + s + "'; allowed: G, R, E, C, J");
   }
   std::string iono = o.ionosphere_klobuchar ? "klobuchar" : "off";
   map.get("ionosphere", iono);
@@ -89,10 +95,11 @@ std::string ProcessConfig::validate() const {
   return {};
 }
 
-bool operator==(const ProcessConfig& a, const ProcessConfig& b) { return to_yaml(a) == to_yaml(b); }
+bool operator==(const ProcessConfig& a, const ProcessConfig& b) {
+  return to_yaml(a) == to_yaml(b);
+}
 
-Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file,
-                                           ProcessConfig defaults) {
+Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file, ProcessConfig defaults) {
   ProcessConfig c = std::move(defaults);
   YamlMap top(node, file);
   std::string mode = mode_name(c.mode);

@@ -5,7 +5,9 @@
 namespace canyon::app {
 
 YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
-    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)),
+    : node_(std::move(node)),
+      file_(std::move(file)),
+      path_(std::move(path)),
       errors_(std::make_shared<std::vector<Error>>()) {
   if (node_ && !node_.IsNull() && !node_.IsMap()) {
     errors_->push_back(Error{(path_.empty() ? std::string("top level") : "'" + path_ + "'") + " must be a map of keys",
@@ -14,7 +16,9 @@ YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
   }
 }
 
-std::string YamlMap::key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+std::string YamlMap::key_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
 
 int YamlMap::line_of(const std::string& key) const {
   if (!node_ || !node_.IsMap()) return 0;
@@ -24,7 +28,9 @@ int YamlMap::line_of(const std::string& key) const {
   return node_.Mark().line + 1;
 }
 
-bool YamlMap::has(const std::string& key) const { return node_ && node_.IsMap() && node_[key].IsDefined(); }
+bool YamlMap::has(const std::string& key) const {
+  return node_ && node_.IsMap() && node_[key].IsDefined();
+}
 
 template <typename T>
 void YamlMap::get_scalar(const std::string& key, T& out, const char* type_name) {
@@ -39,10 +45,18 @@ void YamlMap::get_scalar(const std::string& key, T& out, const char* type_name) 
   }
 }
 
-void YamlMap::get(const std::string& key, double& out) { get_scalar(key, out, "a number"); }
-void YamlMap::get(const std::string& key, int& out) { get_scalar(key, out, "an integer"); }
-void YamlMap::get(const std::string& key, bool& out) { get_scalar(key, out, "true or false"); }
-void YamlMap::get(const std::string& key, std::string& out) { get_scalar(key, out, "a string"); }
+void YamlMap::get(const std::string& key, double& out) {
+  get_scalar(key, out, "a number");
+}
+void YamlMap::get(const std::string& key, int& out) {
+  get_scalar(key, out, "an integer");
+}
+void YamlMap::get(const std::string& key, bool& out) {
+  get_scalar(key, out, "true or false");
+}
+void YamlMap::get(const std::string& key, std::string& out) {
+  get_scalar(key, out, "a string");
+}
 
 void YamlMap::get(const std::string& key, std::vector<std::string>& out) {
   asked_.insert(key);

@@ -1,14 +1,13 @@
 // The `canyon` command: subcommands for canyon's jobs. Exit codes: 0 success, 1 bad input or failed run,
 // 2 bad command line or configuration.
 
-#include <unistd.h>
-
-#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
 #include <string>
 
+#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include "canyon/app/process.hpp"
 #include "canyon/app/process_config.hpp"
@@ -52,6 +51,7 @@ struct ProcessArgs {
   double elevation_mask_deg = -1.0;
   bool print_config = false;
   bool quiet = false;
+  bool verbose = false;
 };
 
 void add_process_command(CLI::App& app, ProcessArgs& args) {
@@ -70,6 +70,7 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
       ->check(CLI::Range(0.0, 89.9));
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
+  cmd->add_flag("-v,--verbose", args.verbose, "Log why each unsolved epoch got no solution (first 100)");
 }
 
 int run_process_command(const ProcessArgs& args) {
@@ -87,7 +88,8 @@ int run_process_command(const ProcessArgs& args) {
   if (!args.nav.empty()) config.nav = args.nav;
   if (!args.out.empty()) config.out = args.out;
   if (!args.coordinates.empty()) {
-    config.coordinates = args.coordinates == "ecef" ? canyon::io::PosCoordinates::Ecef : canyon::io::PosCoordinates::Llh;
+    config.coordinates =
+        args.coordinates == "ecef" ? canyon::io::PosCoordinates::Ecef : canyon::io::PosCoordinates::Llh;
   }
   if (!args.time_format.empty()) {
     config.time_format =
@@ -109,10 +111,13 @@ int run_process_command(const ProcessArgs& args) {
     return kExitInput;
   }
   for (const std::string& w : summary->warnings) spdlog::warn("{}", w);
+  if (args.verbose) {
+    for (const std::string& r : summary->unsolved_reasons) spdlog::info("no solution at {}", r);
+  }
   if (!args.quiet) {
     const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;
-    std::fprintf(stderr, "canyon process: %d epochs, %d solved (%.1f %%), %.2f s wall, solution: %s\n",
-                 summary->epochs, summary->solved, percent, summary->wall_s, config.out.c_str());
+    std::fprintf(stderr, "canyon process: %d epochs, %d solved (%.1f %%), %.2f s wall, solution: %s\n", summary->epochs,
+                 summary->solved, percent, summary->wall_s, config.out.c_str());
   }
   return summary->solved > 0 ? 0 : kExitInput;
 }

@@ -164,6 +164,18 @@ EphemerisStore::EphemerisStore(core::NavigationData nav, EphemerisOptions option
   }
 }
 
+namespace {
+
+/// Health as it concerns canyon's signals. QZSS LNAV's health word has the L1C/B (formerly LEX) signal in its least
+/// significant bit (IS-QZSS-PNT), set on satellites that do not transmit it: it says nothing about L1 C/A, L2C or
+/// L5, so it is ignored.
+bool kepler_healthy(const core::KeplerEphemeris& e) {
+  const int relevant = e.sat.system == Constellation::Qzss ? (e.health & ~0x01) : e.health;
+  return relevant == 0;
+}
+
+}  // namespace
+
 const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat, core::GpsTime t) const {
   if (!sat.valid() || sat.system == Constellation::Glonass) return nullptr;
   const bool galileo = sat.system == Constellation::Galileo;
@@ -171,7 +183,7 @@ const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat
   double best_age_s = 0.0;
   for (const int i : kepler_by_sat_[sat.index()]) {
     const core::KeplerEphemeris& e = nav_.kepler[i];
-    if (e.health != 0 && !options_.use_unhealthy) continue;
+    if (!kepler_healthy(e) && !options_.use_unhealthy) continue;
     // Galileo: only an ephemeris whose toe has passed (age of data > 0), the rule RTKLIB 2.4.3 applies; Galileo
     // toe is at the start of the record's validity, so a future toe means a record not broadcast yet.
     if (galileo && !(e.toe < t)) continue;

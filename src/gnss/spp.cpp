@@ -38,10 +38,10 @@ struct Measurement {
 
 /// Linearised system at one position.
 struct Linearised {
-  Eigen::MatrixXd H;          // n x (3 + clocks in use)
-  Eigen::VectorXd v;          // residuals (m)
-  Eigen::VectorXd variance;   // per measurement (m^2)
-  std::vector<int> rows;      // measurement index of each row
+  Eigen::MatrixXd H;                           // n x (3 + clocks in use)
+  Eigen::VectorXd v;                           // residuals (m)
+  Eigen::VectorXd variance;                    // per measurement (m^2)
+  std::vector<int> rows;                       // measurement index of each row
   std::array<int, kNumClocks> clock_column{};  // column of each clock, -1 if unused
   int num_clocks = 0;
 };
@@ -103,8 +103,8 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
     if (signal == nullptr) continue;
     const auto state = eph.state_at_reception(sat_obs.sat, epoch.time, signal->pseudorange_m);
     if (!state) continue;
-    const int channel = sat_obs.sat.system == Constellation::Glonass ? eph.glonass_channel(sat_obs.sat.prn)
-                                                                      : core::kNoGlonassChannel;
+    const int channel =
+        sat_obs.sat.system == Constellation::Glonass ? eph.glonass_channel(sat_obs.sat.prn) : core::kNoGlonassChannel;
     const auto frequency = core::carrier_frequency_hz(sat_obs.sat.system, signal->code, channel);
     Measurement m;
     m.sat = sat_obs.sat;
@@ -153,8 +153,8 @@ Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>
       lin.clock_column[static_cast<std::size_t>(m.clock)] = lin.num_clocks++;
     }
     const double clock_m = x[3 + m.clock];
-    const double predicted_m = range_m + clock_m - core::kSpeedOfLightMps * m.state.clock_bias_s +
-                               m.group_delay_m + iono_m + tropo_m;
+    const double predicted_m =
+        range_m + clock_m - core::kSpeedOfLightMps * m.state.clock_bias_s + m.group_delay_m + iono_m + tropo_m;
     Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(3 + kNumClocks);
     row.head<3>() = -los_E.transpose();
     row[3 + m.clock] = 1.0;
@@ -224,7 +224,7 @@ Result<Fix> iterate(const std::vector<Measurement>& ms, const std::vector<bool>&
     if (dx.norm() < options.convergence_m) {
       Fix fix;
       fix.lin = linearise(ms, active, x, t, eph, options);  // residuals at the solution
-      if (fix.lin.v.size() != lin.v.size()) continue;     // the mask changed the set at the last step: go on
+      if (fix.lin.v.size() != lin.v.size()) continue;       // the mask changed the set at the last step: go on
       fix.x = x;
       fix.Q = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
       fix.weighted_sum = fix.lin.v.dot(fix.lin.v.cwiseQuotient(fix.lin.variance));
@@ -275,13 +275,11 @@ std::optional<Eigen::Vector3d> solve_velocity(const std::vector<Measurement>& ms
       const Eigen::Vector3d& vs = m.state.v_E_mps;
       const Eigen::Vector3d vr = x.head<3>();
       // Range rate with the Earth-rotation term of the Sagnac correction.
-      const double rate = los_E.dot(vs - vr) +
-                          core::kEarthRotationRateRadps / core::kSpeedOfLightMps *
-                              (vs.y() * p_E.x() + m.state.p_E_m.y() * vr.x() - vs.x() * p_E.y() -
-                               m.state.p_E_m.x() * vr.y());
+      const double rate = los_E.dot(vs - vr) + core::kEarthRotationRateRadps / core::kSpeedOfLightMps *
+                                                   (vs.y() * p_E.x() + m.state.p_E_m.y() * vr.x() - vs.x() * p_E.y() -
+                                                    m.state.p_E_m.x() * vr.y());
       const double observed = -m.wavelength_m * m.doppler_hz;
-      v[static_cast<Eigen::Index>(r)] =
-          observed - (rate + x[3] - core::kSpeedOfLightMps * m.state.clock_drift_sps);
+      v[static_cast<Eigen::Index>(r)] = observed - (rate + x[3] - core::kSpeedOfLightMps * m.state.clock_drift_sps);
       H.row(static_cast<Eigen::Index>(r)) << -los_E.transpose(), 1.0;
     }
     const Eigen::VectorXd dx = (H.transpose() * H).ldlt().solve(H.transpose() * v);
@@ -306,8 +304,8 @@ std::string SppOptions::validate() const {
   return {};
 }
 
-Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides,
-                              const SppOptions& options, const std::optional<Eigen::Vector3d>& initial_p_E_m) {
+Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides, const SppOptions& options,
+                              const std::optional<Eigen::Vector3d>& initial_p_E_m) {
   const std::vector<Measurement> ms = prepare_measurements(epoch, ephemerides, options);
   if (ms.size() < 4) {
     return Error{"too few satellites with pseudorange and ephemeris: " + std::to_string(ms.size())};
@@ -320,8 +318,7 @@ Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore&
   if (!fix) return fix.error();
 
   std::vector<SatelliteId> excluded_by_raim;
-  if (options.raim_fde && !passes_chi_square(*fix) &&
-      fix->lin.v.size() >= fix->lin.H.cols() + 2) {
+  if (options.raim_fde && !passes_chi_square(*fix) && fix->lin.v.size() >= fix->lin.H.cols() + 2) {
     // Try every single exclusion from the converged position; keep the best that passes.
     std::optional<Fix> best;
     std::size_t best_excluded = 0;

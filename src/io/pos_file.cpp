@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <sstream>
 
 #include "canyon/core/constants.hpp"
@@ -14,8 +15,12 @@
 namespace canyon::io {
 namespace {
 
-double signed_sqrt(double c) { return c < 0.0 ? -std::sqrt(-c) : std::sqrt(c); }
-double signed_square(double s) { return s < 0.0 ? -s * s : s * s; }
+double signed_sqrt(double c) {
+  return c < 0.0 ? -std::sqrt(-c) : std::sqrt(c);
+}
+double signed_square(double s) {
+  return s < 0.0 ? -s * s : s * s;
+}
 
 std::string format_time(const core::GpsTime& t, PosTimeFormat format) {
   char buffer[64];
@@ -48,6 +53,12 @@ std::string column_titles(PosCoordinates coordinates, PosTimeFormat time_format)
 }  // namespace
 
 Result<PosWriter> PosWriter::create(const std::string& path, PosWriterOptions options) {
+  // Create the output folder as users expect; a failure shows up as the fopen error below.
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) {
+    std::error_code ignored;
+    std::filesystem::create_directories(parent, ignored);
+  }
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "w"));
   if (!file) return Error{std::string("cannot create solution file: ") + std::strerror(errno), path, 0};
   for (const std::string& line : options.header_lines) std::fprintf(file.get(), "%% %s\n", line.c_str());
@@ -72,12 +83,11 @@ std::string format_pos_record(const core::Solution& s, PosCoordinates coordinate
                   signed_sqrt(P_N(2, 1)), s.age_s, s.ratio);
   } else {
     const Eigen::Matrix3d& P = s.P_E_m2;
-    std::snprintf(buffer, sizeof buffer,
-                  "%s %14.4f %14.4f %14.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f", time.c_str(),
-                  s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z(), static_cast<int>(s.status), s.num_satellites,
-                  std::sqrt(std::max(P(0, 0), 0.0)), std::sqrt(std::max(P(1, 1), 0.0)),
-                  std::sqrt(std::max(P(2, 2), 0.0)), signed_sqrt(P(0, 1)), signed_sqrt(P(1, 2)), signed_sqrt(P(2, 0)),
-                  s.age_s, s.ratio);
+    std::snprintf(
+        buffer, sizeof buffer, "%s %14.4f %14.4f %14.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f",
+        time.c_str(), s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z(), static_cast<int>(s.status), s.num_satellites,
+        std::sqrt(std::max(P(0, 0), 0.0)), std::sqrt(std::max(P(1, 1), 0.0)), std::sqrt(std::max(P(2, 2), 0.0)),
+        signed_sqrt(P(0, 1)), signed_sqrt(P(1, 2)), signed_sqrt(P(2, 0)), s.age_s, s.ratio);
   }
   return buffer;
 }

@@ -1,9 +1,9 @@
 #include "canyon/app/process_config.hpp"
 
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <fstream>
+
+#include <gtest/gtest.h>
 
 #include "canyon/core/constants.hpp"
 
@@ -12,7 +12,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Result<ProcessConfig> parse(const std::string& text) { return parse_process_config(YAML::Load(text), "test.yaml"); }
+Result<ProcessConfig> parse(const std::string& text) {
+  return parse_process_config(YAML::Load(text), "test.yaml");
+}
 
 TEST(ProcessConfigTest, EveryShippedConfigLoads) {
   const fs::path config_dir = fs::path(CANYON_SOURCE_DIR) / "config";

@@ -205,6 +205,19 @@ TEST(Ephemeris, SelectionRules) {
   EXPECT_EQ(fnav_only.select_kepler(inav.sat, inav.toe + 300.0)->iode, 2);
 }
 
+TEST(Ephemeris, QzssL1cbHealthBitDoesNotRejectTheSatellite) {
+  // QZSS LNAV health bit 0 is the L1C/B signal's (set on every QZSS record of matrtklib-static); other bits count.
+  core::KeplerEphemeris qzs = gps_g05();
+  qzs.sat = {Constellation::Qzss, 2};
+  qzs.health = 1;
+  EXPECT_NE(store_of({qzs}).select_kepler(qzs.sat, qzs.toe), nullptr);
+  qzs.health = 0x21;
+  EXPECT_EQ(store_of({qzs}).select_kepler(qzs.sat, qzs.toe), nullptr);
+  core::KeplerEphemeris gps = gps_g05();
+  gps.health = 1;
+  EXPECT_EQ(store_of({gps}).select_kepler(gps.sat, gps.toe), nullptr);
+}
+
 TEST(Ephemeris, StateAtReceptionSolvesLightTime) {
   const EphemerisStore store = store_of({gps_g05()});
   const GpsTime t_rx{2320, 123000.0};

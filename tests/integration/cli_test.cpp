@@ -1,8 +1,8 @@
 // The `canyon` command run as a real process: exit codes and messages for good and bad input.
 
-#include <gtest/gtest.h>
-
 #include <fstream>
+
+#include <gtest/gtest.h>
 
 #include "test_support.hpp"
 
@@ -11,7 +11,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-test::CommandResult canyon(const std::string& args) { return test::run_command(std::string(CANYON_BINARY) + " " + args); }
+test::CommandResult canyon(const std::string& args) {
+  return test::run_command(std::string(CANYON_BINARY) + " " + args);
+}
 
 const fs::path kGsiRover = test::shared_data() / "rtklib-test-gsi-2005/07590920.05o";
 const fs::path kGsiNav = test::shared_data() / "rtklib-test-gsi-2005/07590920.05n";
@@ -19,7 +21,7 @@ const fs::path kGsiNav = test::shared_data() / "rtklib-test-gsi-2005/07590920.05
 TEST(CanyonCli, NoSubcommandIsAUsageError) {
   const auto r = canyon("");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("process"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("subcommand"), std::string::npos) << r.output;
 }
 
 TEST(CanyonCli, UnknownOptionIsAUsageError) {
@@ -55,25 +57,25 @@ TEST(CanyonCli, PrintConfigShowsEffectiveOptions) {
 TEST(CanyonCli, ProcessesRealDataAndSummarises) {
   if (!fs::exists(kGsiRover)) GTEST_SKIP() << "shared dataset not present: " << kGsiRover;
   const fs::path out = test::temp_dir("cli") / "gsi.pos";
-  const auto r = canyon("process --mode spp --rover " + kGsiRover.string() + " --nav " + kGsiNav.string() +
-                        " --out " + out.string());
+  const auto r = canyon("process --mode spp --rover " + kGsiRover.string() + " --nav " + kGsiNav.string() + " --out " +
+                        out.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("120 epochs, 120 solved"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("120 epochs, 115 solved"), std::string::npos) << r.output;  // 5 have GDOP > 30
   std::ifstream in(out);
   std::string line;
   int records = 0;
   while (std::getline(in, line)) {
     if (!line.empty() && line[0] != '%') ++records;
   }
-  EXPECT_EQ(records, 120);
+  EXPECT_EQ(records, 115);
 }
 
 TEST(CanyonCli, UnwritableOutputIsAnError) {
   if (!fs::exists(kGsiRover)) GTEST_SKIP() << "shared dataset not present";
   const auto r = canyon("process --rover " + kGsiRover.string() + " --nav " + kGsiNav.string() +
-                        " --out /nonexistent-dir/x.pos");
+                        " --out /proc/canyon-cannot-create/x.pos");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.output.find("/nonexistent-dir/x.pos"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("/proc/canyon-cannot-create/x.pos"), std::string::npos) << r.output;
 }
 
 TEST(CanyonCli, NavigationFileGivenAsObservationsIsRejected) {

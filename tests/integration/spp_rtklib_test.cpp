@@ -1,14 +1,15 @@
 // Single-point positioning end to end on the real shared datasets, with RTKLIB 2.4.3 (`rnx2rtkp -p 0`) run as a
 // real peer on the same files and options.
 
-#include <gtest/gtest.h>
-
 #include <iostream>
+
+#include <gtest/gtest.h>
 
 #include "canyon/app/process.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
 #include "canyon/io/rinex_obs.hpp"
+
 #include "test_support.hpp"
 
 namespace canyon {
@@ -29,10 +30,7 @@ struct Dataset {
 
 const Dataset kDatasets[] = {
     {"rtklib-test-gsi-2005", "rtklib-test-gsi-2005/07590920.05o", {"rtklib-test-gsi-2005/07590920.05n"}, "G"},
-    {"cssrlib-static-doy078",
-     "cssrlib-static-doy078/SEPT078M1.21O",
-     {"cssrlib-static-doy078/SEPT078M.21P"},
-     "G,E,J"},
+    {"cssrlib-static-doy078", "cssrlib-static-doy078/SEPT078M1.21O", {"cssrlib-static-doy078/SEPT078M.21P"}, "G,E,J"},
     {"cssrlib-kinematic-doy265",
      "cssrlib-kinematic-doy265/SEPT265G.21O",
      {"cssrlib-kinematic-doy265/SEPT2650.21P"},
@@ -75,8 +73,9 @@ std::optional<BothSolutions> run_both(const Dataset& d) {
   auto summary = app::run_process(config);
   EXPECT_TRUE(summary.ok()) << summary.error().to_string();
   if (!summary) return std::nullopt;
-  std::string command = "rnx2rtkp -p 0 -m 15 -sys " + std::string(d.systems) + " -o " + (dir / "rtklib.pos").string() +
-                        " " + config.rover_obs;
+  const fs::path conf = test::write_rtklib_spp_conf(dir, d.systems);
+  std::string command =
+      "rnx2rtkp -k " + conf.string() + " -o " + (dir / "rtklib.pos").string() + " " + config.rover_obs;
   for (const auto& n : config.nav) command += " " + n;
   const auto rtklib_run = test::run_command(command);
   EXPECT_EQ(rtklib_run.exit_code, 0) << command;
@@ -111,12 +110,11 @@ TEST_P(SppAgainstRtklib, MedianDistanceToRtklibIsSmall) {
   EXPECT_GE(both->canyon.size(), both->rtklib.size()) << "canyon solves fewer epochs than RTKLIB";
 }
 
-INSTANTIATE_TEST_SUITE_P(SharedDatasets, SppAgainstRtklib, ::testing::ValuesIn(kDatasets),
-                         [](const auto& info) {
-                           std::string name = info.param.name;
-                           std::replace(name.begin(), name.end(), '-', '_');
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(SharedDatasets, SppAgainstRtklib, ::testing::ValuesIn(kDatasets), [](const auto& info) {
+  std::string name = info.param.name;
+  std::replace(name.begin(), name.end(), '-', '_');
+  return name;
+});
 
 TEST(SppAccuracy, GsiStaticIsAtLeastAsAccurateAsRtklib) {
   const Dataset& d = kDatasets[0];
@@ -137,7 +135,7 @@ TEST(SppAccuracy, GsiStaticIsAtLeastAsAccurateAsRtklib) {
   std::cout << "[ SPP      ] gsi-2005 3D RMS vs header: canyon " << canyon_rms << " m (" << canyon_err.size()
             << " epochs), RTKLIB " << rtklib_rms << " m (" << rtklib_err.size() << " epochs)\n";
   EXPECT_LE(canyon_rms, rtklib_rms);
-  EXPECT_EQ(canyon_err.size(), 120U);
+  EXPECT_EQ(canyon_err.size(), rtklib_err.size());  // 5 of 120 epochs have GDOP > 30 in both
 }
 
 TEST(SppAccuracy, InstinctSimulatorWithinOneMetre) {
@@ -153,8 +151,9 @@ TEST(SppAccuracy, InstinctSimulatorWithinOneMetre) {
   std::vector<double> errors;
   for (const auto& s : *sols) {
     // Truth at 10 Hz: interpolate linearly between the two samples around the solution time.
-    const auto after = std::find_if(truth->begin(), truth->end(), [&](const auto& t) { return s.time - t.time <= 0; });
-    if (after == truth->begin() || after == truth->end()) continue;
+    auto after = std::find_if(truth->begin(), truth->end(), [&](const auto& t) { return s.time - t.time <= 0; });
+    if (after == truth->end()) continue;
+    if (after == truth->begin()) ++after;  // at or before the first sample: extrapolate from the first two
     const auto before = after - 1;
     const double f = (s.time - before->time) / (after->time - before->time);
     const Eigen::Vector3d p_true = before->p_E_m + f * (after->p_E_m - before->p_E_m);

@@ -11,10 +11,10 @@
 namespace canyon::app {
 
 struct ProcessSummary {
-  int epochs = 0;             ///< rover epochs read
-  int solved = 0;             ///< epochs with a solution written
-  double wall_s = 0.0;        ///< wall-clock time of the whole run
-  std::vector<std::string> warnings;       ///< recovered input defects, "file:line: what"
+  int epochs = 0;                             ///< rover epochs read
+  int solved = 0;                             ///< epochs with a solution written
+  double wall_s = 0.0;                        ///< wall-clock time of the whole run
+  std::vector<std::string> warnings;          ///< recovered input defects, "file:line: what"
   std::vector<std::string> unsolved_reasons;  ///< one line per unsolved epoch, "week tow: reason" (first 100)
 };
 

@@ -36,9 +36,9 @@ enum class ProcessMode { Spp };
 
 struct ProcessConfig {
   ProcessMode mode = ProcessMode::Spp;
-  std::string rover_obs;          ///< rover observation file
-  std::vector<std::string> nav;   ///< navigation files
-  std::string out;                ///< solution file
+  std::string rover_obs;         ///< rover observation file
+  std::vector<std::string> nav;  ///< navigation files
+  std::string out;               ///< solution file
   io::PosCoordinates coordinates = io::PosCoordinates::Llh;
   io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
   gnss::SppOptions spp;

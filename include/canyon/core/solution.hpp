@@ -21,8 +21,8 @@ struct Solution {
   Eigen::Matrix3d P_E_m2 = Eigen::Matrix3d::Zero();  ///< its covariance, ECEF
   std::optional<Eigen::Vector3d> v_E_mps;            ///< velocity, ECEF, if known
   int num_satellites = 0;
-  double age_s = 0.0;    ///< age of differential corrections (0 for single point)
-  double ratio = 0.0;    ///< ambiguity ratio test value (0 if none)
+  double age_s = 0.0;  ///< age of differential corrections (0 for single point)
+  double ratio = 0.0;  ///< ambiguity ratio test value (0 if none)
 };
 
 }  // namespace canyon::core

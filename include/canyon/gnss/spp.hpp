@@ -33,14 +33,14 @@ struct SppOptions {
   bool use_galileo = true;
   bool use_beidou = true;
   bool use_qzss = true;
-  bool qzss_own_clock = false;      ///< false: QZSS shares the GPS receiver clock (same system time)
-  bool ionosphere_klobuchar = true; ///< false: no ionosphere model
+  bool qzss_own_clock = false;       ///< false: QZSS shares the GPS receiver clock (same system time)
+  bool ionosphere_klobuchar = true;  ///< false: no ionosphere model
   bool troposphere_saastamoinen = true;
-  double code_sigma_m = 0.3;        ///< zenith pseudorange noise, metres
+  double code_sigma_m = 0.3;  ///< zenith pseudorange noise, metres
   int max_iterations = 10;
   double convergence_m = 1e-4;
-  bool raim_fde = true;             ///< fault detection and exclusion of one satellite
-  double max_gdop = 30.0;           ///< solutions with a larger GDOP are rejected
+  bool raim_fde = true;                     ///< fault detection and exclusion of one satellite
+  double max_gdop = 30.0;                   ///< solutions with a larger GDOP are rejected
   std::vector<core::SatelliteId> excluded;  ///< satellites never used
 
   /// Empty if valid, else the violated rule, e.g. "elevation_mask_rad must be in [0, pi/2)".
@@ -55,21 +55,20 @@ struct SppSolution {
   core::GpsTime time;           ///< receiver time tag corrected by the GPS (or first) receiver clock
   core::GpsTime receiver_time;  ///< time tag of the observation epoch
   Eigen::Vector3d p_E_m = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d P_E_m2 = Eigen::Matrix3d::Zero();  ///< position covariance (ECEF)
-  std::optional<Eigen::Vector3d> v_E_mps;            ///< from Doppler, when enough satellites have it
+  Eigen::Matrix3d P_E_m2 = Eigen::Matrix3d::Zero();                  ///< position covariance (ECEF)
+  std::optional<Eigen::Vector3d> v_E_mps;                            ///< from Doppler, when enough satellites have it
   std::vector<std::pair<core::Constellation, double>> clock_bias_m;  ///< c dt per clock
   Dop dop;
-  int num_satellites = 0;                      ///< used in the fix
+  int num_satellites = 0;  ///< used in the fix
   std::vector<core::SatelliteId> used;
   std::vector<core::SatelliteId> excluded_by_raim;
   int iterations = 0;
   double residual_rms_m = 0.0;
 };
 
-
 /// Solves one epoch. `initial_p_E_m`: a prior position (e.g. the last solution) to start from; the Earth's centre
 /// if none. Error (no file) with a reason on failure; the caller goes on with the next epoch.
-Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides,
-                              const SppOptions& options, const std::optional<Eigen::Vector3d>& initial_p_E_m = {});
+Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides, const SppOptions& options,
+                              const std::optional<Eigen::Vector3d>& initial_p_E_m = {});
 
 }  // namespace canyon::gnss
