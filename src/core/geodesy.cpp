@@ -58,13 +58,9 @@ Eigen::Vector3d enu_to_ecef(const Eigen::Vector3d& d_N, const Geodetic& origin) 
   return rotation_enu_from_ecef(origin).transpose() * d_N;
 }
 
-AzEl azimuth_elevation(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv, const Eigen::Vector3d& p_E_sat) {
-  AzEl result{0.0, kPi / 2.0};
-  if (rcv.height_m <= -kWgs84SemiMajorM + 1.0 || p_E_rcv.norm() < 1.0) {
-    return result;
-  }
-  const Eigen::Vector3d los_E = (p_E_sat - p_E_rcv).normalized();
-  const Eigen::Vector3d los_N = ecef_to_enu(los_E, rcv);
+AzEl azimuth_elevation_from_enu(const Eigen::Vector3d& d_N) {
+  const Eigen::Vector3d los_N = d_N.normalized();
+  AzEl result;
   const double horizontal = los_N.x() * los_N.x() + los_N.y() * los_N.y();
   result.azimuth_rad = horizontal < 1e-12 ? 0.0 : std::atan2(los_N.x(), los_N.y());
   if (result.azimuth_rad < 0.0) {
@@ -72,6 +68,13 @@ AzEl azimuth_elevation(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv, cons
   }
   result.elevation_rad = std::asin(std::clamp(los_N.z(), -1.0, 1.0));
   return result;
+}
+
+AzEl azimuth_elevation(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv, const Eigen::Vector3d& p_E_sat) {
+  if (rcv.height_m <= -kWgs84SemiMajorM + 1.0 || p_E_rcv.norm() < 1.0) {
+    return AzEl{0.0, kPi / 2.0};
+  }
+  return azimuth_elevation_from_enu(ecef_to_enu(p_E_sat - p_E_rcv, rcv));
 }
 
 }  // namespace canyon::core

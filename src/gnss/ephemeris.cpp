@@ -240,29 +240,44 @@ std::optional<SatelliteState> EphemerisStore::state(core::SatelliteId sat, core:
   }
   const core::KeplerEphemeris* e = select_kepler(sat, t_tx);
   if (e == nullptr) return std::nullopt;
+  // Velocity and clock drift by a forward difference over 1 ms: the truncation error (acceleration x step / 2,
+  // about 0.3 mm/s) is far below what Doppler can use, and it costs one orbit evaluation instead of two.
   const PositionClock now = kepler_position_clock(*e, t_tx);
-  const PositionClock before = kepler_position_clock(*e, t_tx - kDiffStepS);
   const PositionClock after = kepler_position_clock(*e, t_tx + kDiffStepS);
   s.p_E_m = now.p_E_m;
-  s.v_E_mps = (after.p_E_m - before.p_E_m) / (2.0 * kDiffStepS);
+  s.v_E_mps = (after.p_E_m - now.p_E_m) / kDiffStepS;
   s.clock_bias_s = now.clock_s;
-  s.clock_drift_sps = (after.clock_s - before.clock_s) / (2.0 * kDiffStepS);
+  s.clock_drift_sps = (after.clock_s - now.clock_s) / kDiffStepS;
   s.variance_m2 = kepler_variance_m2(*e);
   s.iode = e->iode;
   return s;
 }
 
+std::optional<double> EphemerisStore::clock_polynomial_s(core::SatelliteId sat, core::GpsTime t) const {
+  if (sat.system == Constellation::Glonass) {
+    const core::GlonassEphemeris* g = select_glonass(sat, t);
+    if (g == nullptr) return std::nullopt;
+    return g->tau_n_s + g->gamma_n * (t - g->toe);
+  }
+  const core::KeplerEphemeris* e = select_kepler(sat, t);
+  if (e == nullptr) return std::nullopt;
+  const double tc_s = t - e->toc;
+  return e->af0_s + e->af1_sps * tc_s + e->af2_sps2 * tc_s * tc_s;
+}
+
 std::optional<SatelliteState> EphemerisStore::state_at_reception(core::SatelliteId sat, core::GpsTime t_rx,
                                                                  double pseudorange_m, core::GpsTime* t_tx) const {
+  // The transmission time needs the satellite clock to ~1e-7 s (3 cm of orbit motion at most); the clock
+  // polynomial without the relativistic term (< 5e-8 s) gives that, in two fixed-point steps, without any orbit
+  // evaluation. The full state is then computed once.
   const GpsTime t_signal = t_rx - pseudorange_m / kSpeedOfLightMps;
   GpsTime t = t_signal;
-  std::optional<SatelliteState> s;
-  for (int i = 0; i < 3; ++i) {
-    s = state(sat, t);
-    if (!s) return std::nullopt;
-    t = t_signal - s->clock_bias_s;
+  for (int i = 0; i < 2; ++i) {
+    const auto clock_s = clock_polynomial_s(sat, t);
+    if (!clock_s) return std::nullopt;
+    t = t_signal - *clock_s;
   }
-  s = state(sat, t);
+  auto s = state(sat, t);
   if (s && t_tx != nullptr) *t_tx = t;
   return s;
 }

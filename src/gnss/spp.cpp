@@ -34,7 +34,14 @@ struct Measurement {
   double group_delay_m = 0.0;
   double iono_scale = 1.0;  // (f_L1 / f)^2: Klobuchar is an L1 delay
   SatelliteState state;
+  // Atmosphere delays and the position they were computed at: they change by millimetres over 100 m, so they are
+  // refreshed only when the position estimate moves further (a large saving in the iterations).
+  mutable Eigen::Vector3d atmosphere_p_E_m = Eigen::Vector3d::Zero();
+  mutable double iono_m = 0.0;
+  mutable double tropo_m = 0.0;
 };
+
+constexpr double kAtmosphereRefreshM = 100.0;
 
 /// Linearised system at one position.
 struct Linearised {
@@ -115,6 +122,7 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
     m.iono_scale = frequency ? std::pow(1575.42e6 / *frequency, 2) : 1.0;
     m.group_delay_m = core::kSpeedOfLightMps * eph.group_delay_s(sat_obs.sat, signal->code, epoch.time);
     m.state = *state;
+    m.atmosphere_p_E_m.setConstant(1e9);  // never computed
     out.push_back(m);
   }
   return out;
@@ -127,13 +135,19 @@ Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>
   const Eigen::Vector3d p_E = x.head<3>();
   const bool have_position = p_E.norm() > 6.0e6 && p_E.norm() < 7.0e6;
   const core::Geodetic rcv = core::ecef_to_geodetic(p_E);
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(rcv);
   const core::KlobucharParams klob = eph.nav().gps_klobuchar.value_or(default_klobuchar());
 
   Linearised lin;
   lin.clock_column.fill(-1);
-  std::vector<Eigen::RowVectorXd> rows;
+  using Row = Eigen::Matrix<double, 1, 3 + kNumClocks>;
+  std::vector<Row> rows;
   std::vector<double> residuals;
   std::vector<double> variances;
+  rows.reserve(ms.size());
+  residuals.reserve(ms.size());
+  variances.reserve(ms.size());
+  lin.rows.reserve(ms.size());
   for (std::size_t i = 0; i < ms.size(); ++i) {
     if (!active[i]) continue;
     const Measurement& m = ms[i];
@@ -143,11 +157,16 @@ Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>
     double iono_m = 0.0;
     double tropo_m = 0.0;
     if (have_position) {
-      const core::AzEl azel = core::azimuth_elevation(p_E, rcv, m.state.p_E_m);
+      const core::AzEl azel = core::azimuth_elevation_from_enu(R_NE * los_E);
       if (azel.elevation_rad < options.elevation_mask_rad) continue;
       sin_el = std::max(std::sin(azel.elevation_rad), kMinSinElevation);
-      if (options.ionosphere_klobuchar) iono_m = m.iono_scale * klobuchar_delay_m(t, rcv, azel, klob);
-      if (options.troposphere_saastamoinen) tropo_m = saastamoinen_delay_m(rcv, azel.elevation_rad);
+      if ((m.atmosphere_p_E_m - p_E).squaredNorm() > kAtmosphereRefreshM * kAtmosphereRefreshM) {
+        m.iono_m = options.ionosphere_klobuchar ? m.iono_scale * klobuchar_delay_m(t, rcv, azel, klob) : 0.0;
+        m.tropo_m = options.troposphere_saastamoinen ? saastamoinen_delay_m(rcv, azel.elevation_rad) : 0.0;
+        m.atmosphere_p_E_m = p_E;
+      }
+      iono_m = m.iono_m;
+      tropo_m = m.tropo_m;
     }
     if (lin.clock_column[static_cast<std::size_t>(m.clock)] < 0) {
       lin.clock_column[static_cast<std::size_t>(m.clock)] = lin.num_clocks++;
@@ -155,7 +174,7 @@ Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>
     const double clock_m = x[3 + m.clock];
     const double predicted_m =
         range_m + clock_m - core::kSpeedOfLightMps * m.state.clock_bias_s + m.group_delay_m + iono_m + tropo_m;
-    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(3 + kNumClocks);
+    Row row = Row::Zero();
     row.head<3>() = -los_E.transpose();
     row[3 + m.clock] = 1.0;
     rows.push_back(row);

@@ -27,6 +27,9 @@ struct AzEl {
   double azimuth_rad = 0.0;    ///< [0, 2 pi), clockwise from north
   double elevation_rad = 0.0;  ///< [-pi/2, pi/2]
 };
+/// Azimuth and elevation of a direction given in local ENU (need not be unit length, must not be zero).
+[[nodiscard]] AzEl azimuth_elevation_from_enu(const Eigen::Vector3d& d_N);
+
 /// Azimuth and elevation of a satellite at p_E_sat seen from a receiver at p_E_rcv (geodetic `rcv`). A receiver at
 /// the Earth's centre (no position yet) sees every satellite at 90 deg elevation, as RTKLIB assumes.
 [[nodiscard]] AzEl azimuth_elevation(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv,

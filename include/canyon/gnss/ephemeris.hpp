@@ -57,8 +57,12 @@ class EphemerisStore {
   /// Broadcast state of `sat` at GPST transmission time `t_tx`. nullopt if no usable ephemeris.
   [[nodiscard]] std::optional<SatelliteState> state(core::SatelliteId sat, core::GpsTime t_tx) const;
 
+  /// Satellite clock polynomial af0 + af1 dt + af2 dt^2 (GLONASS -tau_n + gamma_n dt) at GPST `t`, without the
+  /// relativistic term: cheap, for the transmission-time iteration. nullopt if no usable ephemeris.
+  [[nodiscard]] std::optional<double> clock_polynomial_s(core::SatelliteId sat, core::GpsTime t) const;
+
   /// State at the transmission time of a signal received at GPST `t_rx` with pseudorange `pseudorange_m`:
-  /// t_tx = t_rx - P / c - dt_sat(t_tx), iterated. Writes t_tx if asked.
+  /// t_tx = t_rx - P / c - dt_sat(t_tx), iterated on the clock polynomial. Writes t_tx if asked.
   [[nodiscard]] std::optional<SatelliteState> state_at_reception(core::SatelliteId sat, core::GpsTime t_rx,
                                                                  double pseudorange_m,
                                                                  core::GpsTime* t_tx = nullptr) const;
