@@ -10,6 +10,10 @@ if (($# != 1)); then
   exit 2
 fi
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if [[ ! -d "$1" ]]; then
+  echo "check-tidy: error: build directory $1 does not exist; build first (scripts/build.sh)" >&2
+  exit 1
+fi
 build_dir="$(cd "$1" && pwd)"
 jobs="${CANYON_TIDY_JOBS:-2}"
 

@@ -10,7 +10,7 @@
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build_dir="${1:-${repo_root}/build}"
+build_dir="$(realpath -m "${1:-${repo_root}/build}")" # absolute: the phases run from the repository root
 scripts="${repo_root}/scripts"
 
 passed=0
