@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Install every build and test dependency of canyon on Debian 12 (bookworm) with apt-get.
+# Does nothing (no network, well under a second) when all packages are already installed.
+# Runs as root, or through sudo when started by another user.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build git pkg-config
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  libeigen3-dev libceres-dev libspdlog-dev libyaml-cpp-dev libcli11-dev zlib1g-dev
+  libgtest-dev libgmock-dev googletest libbenchmark-dev
+  clang-format clang-tidy
+  rtklib
+)
+
+# One dpkg-query call for all packages; a package dpkg has never heard of prints nothing and counts as missing.
+installed="$(dpkg-query -W -f='${Package} ${db:Status-Status}\n' "${packages[@]}" 2> /dev/null || true)"
+missing=()
+for pkg in "${packages[@]}"; do
+  if ! grep -qx "${pkg} installed" <<< "${installed}"; then
+    missing+=("${pkg}")
+  fi
+done
+# fastddsgen is a Java program: apt pulls in a runtime with it, but make sure `java` is there in any case.
+if ! command -v java > /dev/null 2>&1; then
+  missing+=(default-jre-headless)
+fi
+
+if ((${#missing[@]} == 0)); then
+  echo "setup: all ${#packages[@]} packages already installed, nothing to do"
+  exit 0
+fi
+
+echo "setup: missing packages: ${missing[*]}"
+if ((EUID == 0)); then
+  as_root=()
+elif command -v sudo > /dev/null 2>&1; then
+  # Never wait for a password prompt without a terminal (CI, no stdin): fail instead.
+  if [[ -t 0 ]]; then as_root=(sudo); else as_root=(sudo -n); fi
+else
+  echo "setup: error: installing packages needs root; run this script as root or install sudo" >&2
+  exit 1
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q
+"${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+echo "setup: installed ${missing[*]}"
