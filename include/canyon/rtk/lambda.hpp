@@ -1,0 +1,132 @@
+#pragma once
+// Integer ambiguity resolution: MLAMBDA integer least squares, ratio test, partial ambiguity resolution helpers and
+// the fixed-solution update of the float state.
+//
+// ---------------------------------------------------------------------------------------------------------------
+// CONTRACT (mlambda)
+//   Reference: X.-W. Chang, X. Yang, T. Zhou (2005), "MLAMBDA: a modified LAMBDA method for integer least-squares
+//              estimation", J. Geodesy 79:552-565; P.J.G. Teunissen (1995), "The least-squares ambiguity
+//              decorrelation adjustment", J. Geodesy 70:65-82; P. de Jonge, C. Tiberius (1996), "The LAMBDA method
+//              for integer ambiguity estimation: implementation aspects", LGR series 12, TU Delft.
+//   Problem:   a_check = argmin_{a in Z^n} (a_float - a)^T Q_a^{-1} (a_float - a), plus the m best such vectors.
+//   Inputs:    a_float  n-vector of float ambiguities [cycles], finite, n >= 1.
+//              Q_a      n x n covariance of a_float [cycles^2], symmetric (relative tolerance 1e-10, then
+//                       symmetrised) and positive definite (every pivot d_k > n eps max_i Q_ii).
+//              options  num_candidates m >= 1 (default 2), cap on search nodes (default 1e6).
+//   Outputs:   candidates     n x m, column j = the (j+1)-th best integer vector in the a-space, exact integers
+//                             stored as double; squared_norms m-vector, ascending, (a_float - a_j)^T Q_a^{-1} (...).
+//              Z              n x n unimodular (integer, |det Z| = 1), z = Z^T a, Q_z = Z^T Q_a Z (decorrelated).
+//   Storage:   Eigen default, column major; indices 0-based; a's order is the caller's order throughout.
+//   Maths:     1. Q_z = L^T D L with L unit lower triangular, D = diag(d) (computed from the last row up, with the
+//                 symmetric pivoting of MLAMBDA: pivot k takes the smallest remaining diagonal element, so the
+//                 conditional variances d_k tend to decrease towards k = n).
+//              2. Reduction (LLL-like): integer Gauss transformations L <- L G_ik, G_ik = I - round(L_ik) e_i e_k^T
+//                 (i > k), make |L_ik| <= 1/2; neighbours k, k+1 are swapped when
+//                 d_k + L_{k+1,k}^2 d_{k+1} < d_{k+1} (the swap makes d_{k+1} smaller). MLAMBDA's lazy
+//                 transformations: after a swap at k, columns > k are not size-reduced again. Z accumulates all
+//                 transformations; Z^{-1} is accumulated alongside so the back-transform a = Z^{-T} z is exact.
+//              3. Search (Schnorr-Euchner enumeration, depth first, shrinking ellipsoid): with e = L^{-T}(z - z_hat),
+//                 ||.||^2 = sum_k (z_k - zbar_k)^2 / d_k, zbar_k = z_hat_k + sum_{j>k} L_jk (z_j - zbar_j)
+//                 (the conditional mean of z_k given z_{k+1..n}),
+//                 levels from k = n down to 1, values of z_k in zig-zag order around zbar_k; the radius is
+//                 infinite until m leaves are found, then the m-th best squared norm.
+//              a_float is first shifted by round(a_float) (an integer shift commutes with the unimodular Z) so
+//              large ambiguities (1e7 cycles) do not lose the fractional part.
+//   Errors:    n == 0, size mismatch, non-finite input, Q_a not symmetric or not positive definite,
+//              m < 1, search exceeding options.max_search_nodes, reduction not terminating (cap 1e6 steps).
+// ---------------------------------------------------------------------------------------------------------------
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/result.hpp"
+
+namespace canyon::rtk {
+
+/// Options of mlambda().
+struct MlambdaOptions {
+  int num_candidates = 2;                     ///< m, number of best integer vectors returned, >= 1
+  std::int64_t max_search_nodes = 1'000'000;  ///< cap on search steps (one step = one level move), > 0
+
+  /// Ok, or the violated constraint, e.g. "Violated constraint: num_candidates >= 1".
+  [[nodiscard]] Status validate() const;
+};
+
+/// Output of mlambda().
+struct IntegerSearchResult {
+  Eigen::MatrixXd candidates;     ///< n x m, column j = j-th best integer vector in the a-space (integers)
+  Eigen::VectorXd squared_norms;  ///< m, ascending: (a_float - a_j)^T Q_a^{-1} (a_float - a_j)
+  Eigen::MatrixXd Z;              ///< n x n unimodular decorrelation, z = Z^T a, Q_z = Z^T Q_a Z
+  std::int64_t search_nodes = 0;  ///< search steps used (for diagnostics and benchmarks)
+};
+
+/// The decorrelated problem: Z^T Q_a Z = L^T diag(d) L.
+struct Decorrelation {
+  Eigen::MatrixXd Z;      ///< n x n unimodular (integer entries stored as double)
+  Eigen::MatrixXd Z_inv;  ///< n x n, exact integer inverse of Z
+  Eigen::MatrixXd L;      ///< n x n unit lower triangular
+  Eigen::VectorXd d;      ///< n conditional variances, d_k = var(z_k | z_{k+1..n})
+};
+
+/// Steps 1-2 of the contract: validated L^T D L factorisation with symmetric pivoting and reduction of Q_a.
+[[nodiscard]] Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a);
+
+/// Integer least squares by MLAMBDA; see the contract block at the top of this header.
+[[nodiscard]] Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a,
+                                                  const MlambdaOptions& options = {});
+
+/// Outcome of the ratio test.
+struct RatioTestOutcome {
+  double ratio = 0.0;   ///< squared_norms(1) / squared_norms(0); +inf when the best norm is 0 and the second is not
+  bool passed = false;  ///< ratio >= threshold
+};
+
+/// Default ratio-test threshold (the value used by Chang et al. 2005 and common RTK practice).
+inline constexpr double kDefaultRatioThreshold = 3.0;
+
+/// Ratio test second-best / best squared norm. Needs >= 2 candidates (asserted; returns not passed otherwise).
+[[nodiscard]] RatioTestOutcome ratio_test(const IntegerSearchResult& result, double threshold = kDefaultRatioThreshold);
+
+/// Contribution of each ambiguity to the integer least-squares residual of a fixed vector a_fix:
+///   c_i = r(a) - r_{-i}(a),  r(a) = e^T Q_a^{-1} e,  e = a_float - a_fix,
+/// where r_{-i} is the same quadratic form with ambiguity i removed (row/column i dropped from Q_a).
+/// Closed form (Schur complement of Q_a^{-1}): c_i = w_i^2 / W_ii, W = Q_a^{-1}, w = W e. c_i >= 0 is the
+/// square of the w-test statistic of a bias in ambiguity i; pruning the largest c_i lowers the residual most.
+/// Errors: size mismatch, non-finite input, Q_a not symmetric positive definite.
+[[nodiscard]] Result<Eigen::VectorXd> ils_residual_contributions(const Eigen::VectorXd& a_float,
+                                                                 const Eigen::MatrixXd& Q_a,
+                                                                 const Eigen::VectorXd& a_fix);
+
+/// Indices of the `count` largest contributions, largest first (ties: lower index first).
+[[nodiscard]] std::vector<int> largest_contributions(const Eigen::VectorXd& contributions, int count);
+
+/// mlambda on the sub-problem with the ambiguities `removed` dropped.
+struct PartialSolution {
+  std::vector<int> kept_indices;  ///< indices into the original a_float, ascending; row r of candidates is kept[r]
+  IntegerSearchResult search;     ///< result of mlambda on (a_float[kept], Q_a[kept, kept])
+};
+
+/// Removes `removed` (each in [0, n), no duplicates) from (a_float, Q_a) and solves again.
+/// Errors: bad indices, nothing left, and every error of mlambda().
+[[nodiscard]] Result<PartialSolution> solve_without(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a,
+                                                    const std::vector<int>& removed,
+                                                    const MlambdaOptions& options = {});
+
+/// The non-ambiguity block b of the state conditioned on the fixed ambiguities.
+struct FixedSolution {
+  std::vector<int> state_indices;  ///< indices of x that form b, ascending; entry r of x_fixed is x[state_indices[r]]
+  Eigen::VectorXd x_fixed;         ///< x_b - Q_ba Q_a^{-1} (a_float - a_fix)
+  Eigen::MatrixXd P_fixed;         ///< P_bb - Q_ba Q_a^{-1} Q_ab (exactly symmetric)
+};
+
+/// Fixed-solution update. x (N) with covariance P (N x N); ambiguity_indices (n distinct, in [0, N)) pick a_float
+/// = x[ambiguity_indices] with Q_a = P[amb, amb], ordered like a_fix. Uses the Cholesky factor Q_a = C C^T:
+/// G = C^{-1} Q_ab, x_fixed = x_b - G^T C^{-1} (a_float - a_fix), P_fixed = P_bb - G^T G (no inverse formed).
+/// Errors: size mismatch, bad indices, non-finite input, Q_a not positive definite.
+[[nodiscard]] Result<FixedSolution> fixed_solution(const Eigen::VectorXd& x, const Eigen::MatrixXd& P,
+                                                   const std::vector<int>& ambiguity_indices,
+                                                   const Eigen::VectorXd& a_fix);
+
+}  // namespace canyon::rtk

@@ -1,0 +1,554 @@
+// Tests of MLAMBDA and the ambiguity-resolution helpers.
+//
+// Reference solutions come from brute-force enumeration of every integer vector in a box that provably contains
+// the two best: any integer vector u with (u - u_hat)^T Q_u^{-1} (u - u_hat) <= chi2 satisfies
+// |u_i - u_hat_i| <= sqrt(chi2 Q_u,ii), and chi2 = the larger squared norm of two distinct integer vectors (the ones
+// mlambda returned, their norms recomputed here in long double) bounds the second-best norm from above.
+// Badly conditioned problems are enumerated in coordinates u = T^T a of a unimodular T chosen by the test (not by
+// mlambda), where the box is small; integer u and integer a are in one-to-one correspondence.
+
+#include "canyon/rtk/lambda.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include "rtk/gnss_like.hpp"
+
+namespace canyon::rtk {
+namespace {
+
+using MatrixXld = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+using VectorXld = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
+
+// Squared norms agree to 1e-9 relative, except that no double-precision factorisation of the given Q_a can do
+// better than ~cond(Q_a) eps: the bound is max(1e-9, 10 cond eps) (2.2e-7 at cond 1e8; observed ~1e-8 there).
+constexpr double kMaxRelNormError = 1e-9;
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kMaxBoxPoints = 2e7;
+
+double condition_number(const Eigen::MatrixXd& Q) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Q);
+  return eig.eigenvalues().maxCoeff() / eig.eigenvalues().minCoeff();
+}
+
+double norm_tolerance(const Eigen::MatrixXd& Q_a) {
+  return std::max(kMaxRelNormError, 10.0 * condition_number(Q_a) * kEps);
+}
+
+/// (u - u_hat)^T Q^{-1} (u - u_hat) in long double.
+class QuadraticForm {
+ public:
+  QuadraticForm(const Eigen::VectorXd& u_hat, const Eigen::MatrixXd& Q)
+      : u_hat_(u_hat.cast<long double>()), ldlt_(Q.cast<long double>()) {}
+  long double operator()(const Eigen::VectorXd& u) const {
+    const VectorXld e = u.cast<long double>() - u_hat_;
+    return e.dot(ldlt_.solve(e));
+  }
+
+ private:
+  VectorXld u_hat_;
+  Eigen::LDLT<MatrixXld> ldlt_;
+};
+
+struct BruteForceBest {
+  Eigen::VectorXd best, second;
+  double best_norm = std::numeric_limits<double>::infinity();
+  double second_norm = std::numeric_limits<double>::infinity();
+  double box_points = 0.0;
+};
+
+/// Every integer u in the box |u_i - u_hat_i| <= sqrt(chi2 Q_ii); the two smallest norms.
+BruteForceBest brute_force(const Eigen::VectorXd& u_hat, const Eigen::MatrixXd& Q, double chi2) {
+  const Eigen::Index n = u_hat.size();
+  Eigen::VectorXd lo(n), hi(n);
+  BruteForceBest out;
+  out.box_points = 1.0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double half_width = std::sqrt(chi2 * Q(i, i)) * (1.0 + 1e-9) + 1e-9;
+    lo(i) = std::ceil(u_hat(i) - half_width);
+    hi(i) = std::floor(u_hat(i) + half_width);
+    out.box_points *= hi(i) - lo(i) + 1.0;
+  }
+  if (out.box_points > kMaxBoxPoints) return out;  // caller asserts on box_points
+  // Precomputed inverse in long double for speed; the reference accuracy is then ~1e-16 cond(Q).
+  const MatrixXld W = Q.cast<long double>().ldlt().solve(MatrixXld::Identity(n, n));
+  const VectorXld u_hat_ld = u_hat.cast<long double>();
+  Eigen::VectorXd u = lo;
+  while (true) {
+    const VectorXld e = u.cast<long double>() - u_hat_ld;
+    const auto norm = static_cast<double>(e.dot(W * e));
+    if (norm < out.best_norm) {
+      out.second = out.best;
+      out.second_norm = out.best_norm;
+      out.best = u;
+      out.best_norm = norm;
+    } else if (norm < out.second_norm) {
+      out.second = u;
+      out.second_norm = norm;
+    }
+    Eigen::Index i = 0;
+    while (i < n && u(i) == hi(i)) {
+      u(i) = lo(i);
+      ++i;
+    }
+    if (i == n) break;
+    u(i) += 1.0;
+  }
+  return out;
+}
+
+bool is_integer(const Eigen::MatrixXd& M) {
+  return (M.array() == M.array().round()).all();
+}
+
+/// Random unimodular T (and its exact inverse) from integer column operations and swaps.
+void random_unimodular(int n, int operations, std::mt19937_64& rng, Eigen::MatrixXd& T, Eigen::MatrixXd& T_inv) {
+  std::uniform_int_distribution<int> index(0, n - 1);
+  std::uniform_int_distribution<int> multiplier(-2, 2);
+  T = Eigen::MatrixXd::Identity(n, n);
+  T_inv = T;
+  for (int s = 0; s < operations; ++s) {
+    const int i = index(rng);
+    const int j = index(rng);
+    if (i == j) {
+      continue;
+    }
+    const double c = multiplier(rng);
+    T.col(j) += c * T.col(i);          // T <- T (I + c e_i e_j^T)
+    T_inv.row(i) -= c * T_inv.row(j);  // inverse: (I - c e_i e_j^T) T^{-1}
+    if (s % 3 == 0) {
+      T.col(i).swap(T.col(j));
+      T_inv.row(i).swap(T_inv.row(j));
+    }
+  }
+}
+
+Eigen::MatrixXd random_spd(int n, double diagonal_loading, std::mt19937_64& rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::MatrixXd B(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) B(i, j) = normal(rng);
+  }
+  return B.transpose() * B / n + diagonal_loading * Eigen::MatrixXd::Identity(n, n);
+}
+
+Eigen::VectorXd random_float(int n, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> value(-100.0, 100.0);
+  Eigen::VectorXd a(n);
+  for (int i = 0; i < n; ++i) a(i) = value(rng);
+  return a;
+}
+
+/// Q_a = T^{-T} Q_u T^{-1} with a random unimodular T, more column operations until cond(Q_a) >= target_cond.
+/// Returns cond(Q_a) (may overshoot the target).
+double correlated_problem(int n, double target_cond, const Eigen::MatrixXd& Q_u, std::mt19937_64& rng,
+                          Eigen::MatrixXd& T, Eigen::MatrixXd& Q_a) {
+  Eigen::MatrixXd T_inv;
+  double cond = 0.0;
+  for (int operations = n; operations < 400 && cond < target_cond; operations += 2) {
+    random_unimodular(n, operations, rng, T, T_inv);
+    Q_a = T_inv.transpose() * Q_u * T_inv;
+    Q_a = 0.5 * (Q_a + Q_a.transpose());
+    cond = condition_number(Q_a);
+  }
+  return cond;
+}
+
+/// Checks mlambda's two best in the a-space against brute force in u = T^T a coordinates.
+void expect_matches_brute_force(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a, const Eigen::MatrixXd& T,
+                                const Eigen::MatrixXd& Q_u) {
+  auto result = mlambda(a_float, Q_a);
+  ASSERT_TRUE(result.ok()) << result.error().message;
+  const double rel_tol = norm_tolerance(Q_a);
+  ASSERT_EQ(result->candidates.cols(), 2);
+  ASSERT_TRUE(is_integer(result->candidates));
+  ASSERT_NE(result->candidates.col(0), result->candidates.col(1));
+  const Eigen::VectorXd u_hat = T.transpose() * a_float;
+  const QuadraticForm norm_u(u_hat, Q_u);
+  const Eigen::VectorXd u0 = T.transpose() * result->candidates.col(0);
+  const Eigen::VectorXd u1 = T.transpose() * result->candidates.col(1);
+  const auto independent0 = static_cast<double>(norm_u(u0));
+  const auto independent1 = static_cast<double>(norm_u(u1));
+  EXPECT_NEAR(result->squared_norms(0), independent0, rel_tol * independent0);
+  EXPECT_NEAR(result->squared_norms(1), independent1, rel_tol * independent1);
+
+  const BruteForceBest ref = brute_force(u_hat, Q_u, std::max(independent0, independent1));
+  ASSERT_LE(ref.box_points, kMaxBoxPoints) << "test problem too large for brute force";
+  EXPECT_EQ(u0, ref.best) << "n = " << a_float.size();
+  EXPECT_EQ(u1, ref.second) << "n = " << a_float.size();
+  EXPECT_NEAR(result->squared_norms(0), ref.best_norm, rel_tol * ref.best_norm);
+  EXPECT_NEAR(result->squared_norms(1), ref.second_norm, rel_tol * ref.second_norm);
+}
+
+TEST(MlambdaTest, OneDimension) {
+  auto result = mlambda(Eigen::VectorXd::Constant(1, 2.3), Eigen::MatrixXd::Constant(1, 1, 0.1));
+  ASSERT_TRUE(result.ok());
+  EXPECT_EQ(result->candidates(0, 0), 2.0);
+  EXPECT_EQ(result->candidates(0, 1), 3.0);
+  EXPECT_NEAR(result->squared_norms(0), 0.09 / 0.1, 1e-12);
+  EXPECT_NEAR(result->squared_norms(1), 0.49 / 0.1, 1e-12);
+}
+
+TEST(MlambdaTest, MatchesBruteForceOnWellConditionedProblems) {
+  std::mt19937_64 rng(7);
+  for (int n = 2; n <= 8; ++n) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const Eigen::MatrixXd Q_a = 0.05 * random_spd(n, 0.5, rng);
+      const Eigen::VectorXd a_float = random_float(n, rng);
+      SCOPED_TRACE(::testing::Message() << "n = " << n << " trial " << trial << " cond " << condition_number(Q_a));
+      expect_matches_brute_force(a_float, Q_a, Eigen::MatrixXd::Identity(n, n), Q_a);
+    }
+  }
+}
+
+TEST(MlambdaTest, MatchesBruteForceOnIllConditionedLowDimensionalProblems) {
+  // Q_a = R diag(lambda) R^T with a random rotation R, condition number 1e3 .. 1e8, enumerated directly in a.
+  std::mt19937_64 rng(11);
+  for (int n = 2; n <= 3; ++n) {
+    for (double cond = 1e3; cond <= 1e8 * 1.01; cond *= 10.0) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const Eigen::HouseholderQR<Eigen::MatrixXd> qr(random_spd(n, 0.0, rng));
+        const Eigen::MatrixXd R = qr.householderQ();
+        Eigen::VectorXd lambda = Eigen::VectorXd::LinSpaced(n, 0.0, 1.0);
+        lambda = (-std::log(cond) * lambda.array()).exp();  // 1 .. 1/cond
+        const Eigen::MatrixXd Q_a = 0.5 * R * lambda.asDiagonal() * R.transpose();
+        const Eigen::MatrixXd Q_sym = 0.5 * (Q_a + Q_a.transpose());
+        const Eigen::VectorXd a_float = random_float(n, rng);
+        SCOPED_TRACE(::testing::Message() << "n = " << n << " cond " << condition_number(Q_sym));
+        EXPECT_GT(condition_number(Q_sym), 0.5 * cond);
+        expect_matches_brute_force(a_float, Q_sym, Eigen::MatrixXd::Identity(n, n), Q_sym);
+      }
+    }
+  }
+}
+
+TEST(MlambdaTest, MatchesBruteForceOnHighlyCorrelatedProblems) {
+  // Q_a = T^{-T} Q_u T^{-1}: correlated like DD ambiguities, condition numbers 1e3 .. 1e8; brute force in u = T^T a.
+  std::mt19937_64 rng(13);
+  double largest_cond = 0.0;
+  int problems = 0;
+  for (int n = 2; n <= 8; ++n) {
+    for (int trial = 0; trial < 12; ++trial) {
+      const Eigen::MatrixXd Q_u = 0.02 * random_spd(n, 0.3, rng);
+      const double target_cond = std::pow(10.0, 3.0 + 5.0 * trial / 11.0);
+      Eigen::MatrixXd T, Q_a;
+      const double cond = correlated_problem(n, target_cond, Q_u, rng, T, Q_a);
+      if (cond < 1e3 || cond > 1e9) continue;  // generator overshoot or undershoot; counted below
+      ++problems;
+      largest_cond = std::max(largest_cond, cond);
+      const Eigen::VectorXd a_float = random_float(n, rng);
+      SCOPED_TRACE(::testing::Message() << "n = " << n << " trial " << trial << " cond " << cond);
+      expect_matches_brute_force(a_float, Q_a, T, Q_u);
+    }
+  }
+  EXPECT_GE(problems, 60);
+  EXPECT_GT(largest_cond, 1e7);
+}
+
+TEST(MlambdaTest, DeJongeTiberiusExample) {
+  // Three-dimensional example of de Jonge & Tiberius (1996, LGR-12) and Teunissen's LAMBDA papers, numbers as
+  // recalled from the literature: a_float = (5.45, 3.10, 2.97), Q_a below; the published ILS solution is (5, 3, 4).
+  // The brute-force check makes the expected answer independent of that recollection.
+  Eigen::Vector3d a_float(5.45, 3.10, 2.97);
+  Eigen::Matrix3d Q_a;
+  Q_a << 6.290, 5.978, 0.544,  //
+      5.978, 6.292, 2.340,     //
+      0.544, 2.340, 6.288;
+  auto result = mlambda(a_float, Q_a);
+  ASSERT_TRUE(result.ok()) << result.error().message;
+  EXPECT_EQ(Eigen::Vector3d(result->candidates.col(0)), Eigen::Vector3d(5, 3, 4));
+  expect_matches_brute_force(a_float, Q_a, Eigen::Matrix3d::Identity(), Q_a);
+}
+
+TEST(MlambdaTest, LargeAmbiguitiesKeepTheirFractionalPart) {
+  std::mt19937_64 rng(17);
+  const auto p = testing::gnss_like_problem(10, rng);
+  const double offset_cyc = 3.0e7;  // a realistic absolute ambiguity magnitude
+  auto small = mlambda(p.a_float, p.Q_a);
+  auto large = mlambda(p.a_float.array() + offset_cyc, p.Q_a);
+  ASSERT_TRUE(small.ok() && large.ok());
+  EXPECT_EQ(large->candidates, (small->candidates.array() + offset_cyc).matrix());
+  EXPECT_NEAR(large->squared_norms(0), small->squared_norms(0), 1e-6 * small->squared_norms(0));
+}
+
+TEST(MlambdaTest, ReturnsTheRequestedNumberOfCandidatesInOrder) {
+  std::mt19937_64 rng(19);
+  const auto p = testing::gnss_like_problem(6, rng);
+  MlambdaOptions options;
+  options.num_candidates = 5;
+  auto result = mlambda(p.a_float, p.Q_a, options);
+  ASSERT_TRUE(result.ok());
+  ASSERT_EQ(result->candidates.cols(), 5);
+  const QuadraticForm norm(p.a_float, p.Q_a);
+  for (int j = 0; j < 5; ++j) {
+    const auto independent = static_cast<double>(norm(result->candidates.col(j)));
+    EXPECT_NEAR(result->squared_norms(j), independent, 1e-8 * independent);
+    if (j > 0) {
+      EXPECT_GE(result->squared_norms(j), result->squared_norms(j - 1));
+    }
+  }
+}
+
+/// Structural checks of a decorrelation; returns cond(Z^T Q_a Z).
+double check_decorrelation(const Eigen::MatrixXd& Q_a) {
+  const Eigen::Index n = Q_a.rows();
+  auto dec = decorrelate(Q_a);
+  EXPECT_TRUE(dec.ok()) << dec.error().message;
+  if (!dec.ok()) return std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(is_integer(dec->Z));
+  EXPECT_TRUE(is_integer(dec->Z_inv));
+  EXPECT_EQ(dec->Z * dec->Z_inv, Eigen::MatrixXd::Identity(n, n));  // exact in integer arithmetic
+  EXPECT_NEAR(std::abs(dec->Z.fullPivLu().determinant()), 1.0, 1e-6);
+  const Eigen::MatrixXd Q_z = dec->Z.transpose() * Q_a * dec->Z;
+  const Eigen::MatrixXd LtDL = dec->L.transpose() * dec->d.asDiagonal() * dec->L;
+  // Backward-error scale of forming Z^T Q_a Z in double: eps |Z|^T |Q_a| |Z|.
+  const Eigen::MatrixXd Z_abs = dec->Z.cwiseAbs();
+  const double scale = (Z_abs.transpose() * Q_a.cwiseAbs() * Z_abs).maxCoeff();
+  EXPECT_LT((Q_z - LtDL).cwiseAbs().maxCoeff(), 1e-10 * Q_z.cwiseAbs().maxCoeff() + 1e3 * kEps * scale);
+  EXPECT_TRUE(dec->L.isLowerTriangular(0.0));
+  EXPECT_EQ(dec->L.diagonal(), Eigen::VectorXd::Ones(n));
+  // Size-reduced and ordered: the LLL-like conditions the reduction stops on.
+  for (Eigen::Index k = 0; k + 1 < n; ++k) {
+    for (Eigen::Index i = k + 1; i < n; ++i) EXPECT_LE(std::abs(dec->L(i, k)), 0.5 + 1e-12);
+    const double delta = dec->d(k) + dec->L(k + 1, k) * dec->L(k + 1, k) * dec->d(k + 1);
+    EXPECT_GE(delta, (1.0 - 1e-8) * dec->d(k + 1) * (1.0 - 1e-12));
+  }
+  return condition_number(Q_z);
+}
+
+TEST(DecorrelateTest, GnssLikeAmbiguitiesAreDecorrelatedByAUnimodularZ) {
+  std::mt19937_64 rng(23);
+  for (int n : {5, 8, 15, 30}) {
+    for (int trial = 0; trial < 5; ++trial) {
+      const Eigen::MatrixXd Q_a = testing::gnss_like_covariance(n, rng);
+      const double cond_a = condition_number(Q_a);
+      const double cond_z = check_decorrelation(Q_a);
+      EXPECT_LT(cond_z, cond_a / 10.0) << "n = " << n << " cond_a " << cond_a;
+    }
+  }
+}
+
+TEST(DecorrelateTest, HighlyCorrelatedProblemsAreNotMadeWorse) {
+  std::mt19937_64 rng(53);
+  for (int n = 2; n <= 10; ++n) {
+    for (int trial = 0; trial < 5; ++trial) {
+      Eigen::MatrixXd T, Q_a;
+      const double cond_a = correlated_problem(n, std::pow(10.0, 3.0 + trial), random_spd(n, 0.3, rng), rng, T, Q_a);
+      EXPECT_GE(cond_a, 1e3);
+      EXPECT_LE(check_decorrelation(Q_a), cond_a) << "n = " << n << " cond_a " << cond_a;
+    }
+  }
+}
+
+TEST(DecorrelateTest, CodeOnlyThreeSatelliteCaseDocumentsThatCondMayGrow) {
+  // Three DD ambiguities from code only: Q_a ~ I + 1 1^T (cond 4). The reduction orders the conditional variances
+  // but the condition number goes to 3 + 2 sqrt(2) = 5.83: LLL-type reduction does not promise a smaller
+  // condition number, only a size-reduced, ordered L^T D L (and a search that is never slower in practice).
+  const Eigen::MatrixXd Q_a = Eigen::MatrixXd::Identity(3, 3) + Eigen::MatrixXd::Ones(3, 3);
+  EXPECT_NEAR(condition_number(Q_a), 4.0, 1e-12);
+  EXPECT_LT(check_decorrelation(Q_a), 6.0);
+}
+
+TEST(MlambdaTest, RejectsBadInput) {
+  const Eigen::Vector2d a(0.3, 0.4);
+  Eigen::Matrix2d indefinite;
+  indefinite << 1.0, 2.0, 2.0, 1.0;
+  EXPECT_FALSE(mlambda(a, indefinite).ok());
+  EXPECT_NE(mlambda(a, indefinite).error().message.find("positive definite"), std::string::npos);
+  Eigen::Matrix2d singular;
+  singular << 1.0, 1.0, 1.0, 1.0;
+  EXPECT_FALSE(mlambda(a, singular).ok());
+  Eigen::Matrix2d asymmetric;
+  asymmetric << 1.0, 0.1, 0.2, 1.0;
+  EXPECT_FALSE(mlambda(a, asymmetric).ok());
+  EXPECT_FALSE(mlambda(Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Matrix2d::Identity()).ok());
+  EXPECT_FALSE(mlambda(a, Eigen::MatrixXd::Identity(2, 3)).ok());
+  EXPECT_FALSE(mlambda(Eigen::VectorXd(), Eigen::MatrixXd()).ok());
+  EXPECT_FALSE(mlambda(Eigen::Vector2d(std::nan(""), 0.0), Eigen::Matrix2d::Identity()).ok());
+  Eigen::Matrix2d with_inf = Eigen::Matrix2d::Identity();
+  with_inf(1, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(mlambda(a, with_inf).ok());
+  MlambdaOptions no_candidates;
+  no_candidates.num_candidates = 0;
+  EXPECT_FALSE(mlambda(a, Eigen::Matrix2d::Identity(), no_candidates).ok());
+  EXPECT_FALSE(decorrelate(indefinite).ok());
+}
+
+TEST(MlambdaTest, SearchCapReturnsAnError) {
+  std::mt19937_64 rng(29);
+  const auto p = testing::gnss_like_problem(12, rng);
+  MlambdaOptions options;
+  options.max_search_nodes = 5;
+  auto result = mlambda(p.a_float, p.Q_a, options);
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.error().message.find("cap"), std::string::npos) << result.error().message;
+  EXPECT_TRUE(mlambda(p.a_float, p.Q_a).ok());
+}
+
+TEST(MlambdaTest, GnssLikeDimension30IsFastAndOptimalAgainstObviousCandidates) {
+  std::mt19937_64 rng(31);
+  const auto start = std::chrono::steady_clock::now();
+  constexpr int kProblems = 50;
+  for (int trial = 0; trial < kProblems; ++trial) {
+    const auto p = testing::gnss_like_problem(30, rng);
+    auto result = mlambda(p.a_float, p.Q_a);
+    ASSERT_TRUE(result.ok()) << result.error().message;
+    const QuadraticForm norm(p.a_float, p.Q_a);
+    const auto bootstrapped = static_cast<double>(norm(p.a_float.array().round().matrix()));
+    EXPECT_LE(result->squared_norms(0), bootstrapped * (1.0 + 1e-9));
+    EXPECT_NEAR(result->squared_norms(0), static_cast<double>(norm(result->candidates.col(0))),
+                1e-8 * result->squared_norms(0));
+  }
+  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(elapsed_s / kProblems, 0.05) << "mean time per n = 30 problem";
+}
+
+TEST(RatioTest, ThresholdAndEdgeCases) {
+  IntegerSearchResult r;
+  r.squared_norms = Eigen::Vector2d(1.0, 3.5);
+  EXPECT_TRUE(ratio_test(r).passed);
+  EXPECT_DOUBLE_EQ(ratio_test(r).ratio, 3.5);
+  EXPECT_FALSE(ratio_test(r, 4.0).passed);
+  r.squared_norms = Eigen::Vector2d(1.0, 2.9);
+  EXPECT_FALSE(ratio_test(r).passed);
+  r.squared_norms = Eigen::Vector2d(0.0, 2.0);
+  EXPECT_TRUE(ratio_test(r).passed);
+  EXPECT_TRUE(std::isinf(ratio_test(r).ratio));
+  r.squared_norms = Eigen::Vector2d(1.0, 3.0);
+  EXPECT_TRUE(ratio_test(r).passed);  // >= threshold passes
+}
+
+TEST(PartialArTest, ContributionsEqualTheDecreaseWhenRemovingEachAmbiguity) {
+  std::mt19937_64 rng(37);
+  for (int trial = 0; trial < 10; ++trial) {
+    const int n = 4 + trial;
+    const auto p = testing::gnss_like_problem(n, rng);
+    const Eigen::VectorXd a_fix = p.a_float.array().round();
+    auto c = ils_residual_contributions(p.a_float, p.Q_a, a_fix);
+    ASSERT_TRUE(c.ok()) << c.error().message;
+    const double full = static_cast<double>(QuadraticForm(p.a_float, p.Q_a)(a_fix));
+    for (int i = 0; i < n; ++i) {
+      std::vector<int> keep;
+      for (int j = 0; j < n; ++j) {
+        if (j != i) keep.push_back(j);
+      }
+      Eigen::VectorXd a_sub(n - 1), fix_sub(n - 1);
+      Eigen::MatrixXd Q_sub(n - 1, n - 1);
+      for (int r = 0; r < n - 1; ++r) {
+        a_sub(r) = p.a_float(keep[r]);
+        fix_sub(r) = a_fix(keep[r]);
+        for (int s = 0; s < n - 1; ++s) Q_sub(r, s) = p.Q_a(keep[r], keep[s]);
+      }
+      const double reduced = static_cast<double>(QuadraticForm(a_sub, Q_sub)(fix_sub));
+      EXPECT_GE((*c)(i), 0.0);
+      EXPECT_NEAR((*c)(i), full - reduced, 1e-7 * full) << "i = " << i;
+    }
+  }
+}
+
+TEST(PartialArTest, BiasedAmbiguityHasTheLargestContribution) {
+  std::mt19937_64 rng(41);
+  std::uniform_int_distribution<int> pick(0, 11);
+  int detected = 0;
+  constexpr int kTrials = 20;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    auto p = testing::gnss_like_problem(12, rng);
+    // Bias-free float solution close to its integers, then a half-cycle slip on one ambiguity.
+    const Eigen::VectorXd a_true = p.a_float.array().round();
+    Eigen::VectorXd a_float = a_true + 0.01 * (p.a_float - a_true);
+    const int biased = pick(rng);
+    a_float(biased) += 0.5;
+    auto c = ils_residual_contributions(a_float, p.Q_a, a_true);
+    ASSERT_TRUE(c.ok());
+    if (largest_contributions(*c, 1).front() == biased) ++detected;
+  }
+  EXPECT_EQ(detected, kTrials);
+}
+
+TEST(PartialArTest, LargestContributionsOrder) {
+  EXPECT_EQ(largest_contributions(Eigen::Vector4d(0.1, 5.0, 2.0, 5.0), 3), (std::vector<int>{1, 3, 2}));
+  EXPECT_EQ(largest_contributions(Eigen::Vector2d(0.1, 5.0), 5), (std::vector<int>{1, 0}));
+}
+
+TEST(PartialArTest, SolveWithoutMatchesTheExtractedSubproblem) {
+  std::mt19937_64 rng(43);
+  const auto p = testing::gnss_like_problem(9, rng);
+  const std::vector<int> removed{7, 2};
+  auto partial = solve_without(p.a_float, p.Q_a, removed);
+  ASSERT_TRUE(partial.ok()) << partial.error().message;
+  const std::vector<int> expected_kept{0, 1, 3, 4, 5, 6, 8};
+  EXPECT_EQ(partial->kept_indices, expected_kept);
+  Eigen::VectorXd a_sub(7);
+  Eigen::MatrixXd Q_sub(7, 7);
+  for (int r = 0; r < 7; ++r) {
+    a_sub(r) = p.a_float(expected_kept[r]);
+    for (int s = 0; s < 7; ++s) Q_sub(r, s) = p.Q_a(expected_kept[r], expected_kept[s]);
+  }
+  auto direct = mlambda(a_sub, Q_sub);
+  ASSERT_TRUE(direct.ok());
+  EXPECT_EQ(partial->search.candidates, direct->candidates);
+  EXPECT_EQ(partial->search.squared_norms, direct->squared_norms);
+
+  EXPECT_FALSE(solve_without(p.a_float, p.Q_a, {9}).ok());
+  EXPECT_FALSE(solve_without(p.a_float, p.Q_a, {-1}).ok());
+  EXPECT_FALSE(solve_without(p.a_float, p.Q_a, {3, 3}).ok());
+  EXPECT_FALSE(solve_without(p.a_float, p.Q_a, {0, 1, 2, 3, 4, 5, 6, 7, 8}).ok());
+}
+
+TEST(FixedSolutionTest, MatchesConditionalGaussianFromThePrecisionMatrix) {
+  std::mt19937_64 rng(47);
+  for (int trial = 0; trial < 10; ++trial) {
+    constexpr int kN = 11;
+    const Eigen::MatrixXd P = random_spd(kN, 0.05, rng);
+    const Eigen::VectorXd x = random_float(kN, rng);
+    const std::vector<int> amb{7, 2, 5, 10};
+    const Eigen::Vector4d a_fix(std::round(x(7)) + 1.0, std::round(x(2)), std::round(x(5)) - 2.0, std::round(x(10)));
+    auto fixed = fixed_solution(x, P, amb, a_fix);
+    ASSERT_TRUE(fixed.ok()) << fixed.error().message;
+    const std::vector<int> b{0, 1, 3, 4, 6, 8, 9};
+    ASSERT_EQ(fixed->state_indices, b);
+    // Conditional Gaussian: Lambda = P^{-1}; cov(b | a) = Lambda_bb^{-1},
+    // E(b | a = a_fix) = x_b - Lambda_bb^{-1} Lambda_ba (a_fix - x_a).
+    const Eigen::MatrixXd Lambda = P.inverse();
+    Eigen::MatrixXd Lambda_bb(7, 7), Lambda_ba(7, 4);
+    Eigen::VectorXd x_b(7), x_a(4);
+    for (int r = 0; r < 7; ++r) {
+      x_b(r) = x(b[r]);
+      for (int s = 0; s < 7; ++s) Lambda_bb(r, s) = Lambda(b[r], b[s]);
+      for (int s = 0; s < 4; ++s) Lambda_ba(r, s) = Lambda(b[r], amb[s]);
+    }
+    for (int s = 0; s < 4; ++s) x_a(s) = x(amb[s]);
+    const Eigen::MatrixXd cov_expected = Lambda_bb.inverse();
+    const Eigen::VectorXd mean_expected = x_b - cov_expected * Lambda_ba * (a_fix - x_a);
+    EXPECT_LT((fixed->x_fixed - mean_expected).cwiseAbs().maxCoeff(), 1e-9 * (1.0 + mean_expected.norm()));
+    EXPECT_LT((fixed->P_fixed - cov_expected).cwiseAbs().maxCoeff(), 1e-10 * cov_expected.norm());
+    EXPECT_EQ(fixed->P_fixed, fixed->P_fixed.transpose());
+  }
+}
+
+TEST(FixedSolutionTest, RejectsBadInput) {
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(4);
+  const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(4, 4);
+  EXPECT_FALSE(fixed_solution(x, P, {1, 1}, Eigen::Vector2d(0, 0)).ok());
+  EXPECT_FALSE(fixed_solution(x, P, {1, 4}, Eigen::Vector2d(0, 0)).ok());
+  EXPECT_FALSE(fixed_solution(x, P, {1}, Eigen::Vector2d(0, 0)).ok());
+  EXPECT_FALSE(fixed_solution(x, Eigen::MatrixXd::Identity(3, 3), {1}, Eigen::VectorXd::Zero(1)).ok());
+  Eigen::MatrixXd not_pd = P;
+  not_pd(2, 2) = -1.0;
+  EXPECT_FALSE(fixed_solution(x, not_pd, {2}, Eigen::VectorXd::Zero(1)).ok());
+  Eigen::VectorXd x_nan = x;
+  x_nan(0) = std::nan("");
+  EXPECT_FALSE(fixed_solution(x_nan, P, {2}, Eigen::VectorXd::Zero(1)).ok());
+  EXPECT_TRUE(fixed_solution(x, P, {0, 1, 2, 3}, Eigen::Vector4d::Zero()).ok());  // nothing but ambiguities
+}
+
+}  // namespace
+}  // namespace canyon::rtk
