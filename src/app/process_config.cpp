@@ -36,18 +36,19 @@ void parse_spp(YamlMap map, gnss::SppOptions& o) {
   map.get("systems", systems);
   o.use_gps = o.use_glonass = o.use_galileo = o.use_beidou = o.use_qzss = false;
   for (const std::string& s : systems) {
-    if (s == "G")
+    if (s == "G") {
       o.use_gps = true;
-    else if (s == "R")
+    } else if (s == "R") {
       o.use_glonass = true;
-    else if (s == "E")
+    } else if (s == "E") {
       o.use_galileo = true;
-    else if (s == "C")
+    } else if (s == "C") {
       o.use_beidou = true;
-    else if (s == "J")
+    } else if (s == "J") {
       o.use_qzss = true;
-    else
+    } else {
       map.fail("systems", "has '" + s + "'; allowed: G, R, E, C, J");
+    }
   }
   std::string iono = o.ionosphere_klobuchar ? "klobuchar" : "off";
   map.get("ionosphere", iono);

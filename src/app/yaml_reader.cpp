@@ -4,11 +4,8 @@
 
 namespace canyon::app {
 
-YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
-    : node_(std::move(node)),
-      file_(std::move(file)),
-      path_(std::move(path)),
-      errors_(std::make_shared<std::vector<Error>>()) {
+YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)), errors_(std::make_shared<std::vector<Error>>()) {
   if (node_ && !node_.IsNull() && !node_.IsMap()) {
     errors_->push_back(Error{(path_.empty() ? std::string("top level") : "'" + path_ + "'") + " must be a map of keys",
                              file_, node_.Mark().line + 1});

@@ -122,9 +122,7 @@ int run_process_command(const ProcessArgs& args) {
   return summary->solved > 0 ? 0 : kExitInput;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run_main(int argc, char** argv) {
   CLI::App app{"canyon: centimetre-level GNSS carrier-phase positioning fused with visual-inertial odometry"};
   app.require_subcommand(1);
   ProcessArgs process_args;
@@ -142,4 +140,16 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("canyon: %l: %v");
   if (app.got_subcommand("process")) return run_process_command(process_args);
   return kExitUsage;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Bad input is reported through Result; an exception here is a bug or resource exhaustion: say so and fail.
+  try {
+    return run_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "canyon: internal error: " << e.what() << "\n";
+    return kExitInput;
+  }
 }

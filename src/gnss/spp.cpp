@@ -278,9 +278,9 @@ Dop compute_dop(const Linearised& lin, const Eigen::Vector3d& p_E) {
 std::optional<Eigen::Vector3d> solve_velocity(const std::vector<Measurement>& ms, const Linearised& lin,
                                               const Eigen::Vector3d& p_E) {
   std::vector<int> rows;
-  for (std::size_t r = 0; r < lin.rows.size(); ++r) {
-    const Measurement& m = ms[static_cast<std::size_t>(lin.rows[r])];
-    if (core::has_value(m.doppler_hz) && m.wavelength_m > 0.0) rows.push_back(lin.rows[r]);
+  for (const int row : lin.rows) {
+    const Measurement& m = ms[static_cast<std::size_t>(row)];
+    if (core::has_value(m.doppler_hz) && m.wavelength_m > 0.0) rows.push_back(row);
   }
   if (rows.size() < 5) return std::nullopt;  // 4 unknowns and at least one check
   Eigen::VectorXd x = Eigen::VectorXd::Zero(4);

@@ -125,7 +125,9 @@ Result<std::vector<core::Solution>> read_pos_file(const std::string& path) {
       core::CalendarTime c;
       if (std::sscanf(first.c_str(), "%d/%d/%d", &c.year, &c.month, &c.day) != 3 ||
           std::sscanf(clock.c_str(), "%d:%d:%lf", &c.hour, &c.minute, &c.second) != 3 || !core::is_valid(c)) {
-        return reader->error("bad date/time '" + first + " " + clock + "'");
+        std::string message = "bad date/time '";
+        message.append(first).append(" ").append(clock).append("'");
+        return reader->error(std::move(message));
       }
       s.time = core::calendar_to_gps(c);
     } else {

@@ -181,7 +181,7 @@ class NavParser {
                              std::to_string(lines));
       }
       for (int k = 0; k < 4; ++k) {
-        Status s = parse_number(*line, indent() + 19 * k, values);
+        Status s = parse_number(*line, indent() + 19 * static_cast<std::size_t>(k), values);
         if (!s.ok()) return s;
       }
     }
@@ -251,7 +251,7 @@ class NavParser {
 
     std::vector<double> v;
     for (int k = 0; k < 3; ++k) {
-      Status s = parse_number(line, first_value + 19 * k, v);
+      Status s = parse_number(line, first_value + 19 * static_cast<std::size_t>(k), v);
       if (!s.ok()) return s;
     }
     if (sat->system == Constellation::Glonass) {

@@ -196,7 +196,7 @@ Status write_satellite(std::string& out, const core::SatelliteObs& sat, const st
   for (const Column& c : columns) {
     const core::SignalObs* s = c.kind != 0 ? sat.find(c.signal) : nullptr;
     const double value = s != nullptr ? observable(*s, c.kind) : core::kNoValue;
-    if (!core::has_value(value)) {
+    if (s == nullptr || !core::has_value(value)) {
       out.append(16, ' ');
       continue;
     }

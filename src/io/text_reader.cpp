@@ -108,7 +108,7 @@ std::string_view trim(std::string_view text) {
 std::optional<double> parse_double(std::string_view field, std::optional<double> blank_value) {
   field = trim(field);
   if (field.empty()) return blank_value;
-  char buffer[64];
+  char buffer[64] = {};
   if (field.size() >= sizeof buffer) return std::nullopt;
   std::size_t n = 0;
   for (const char c : field) {

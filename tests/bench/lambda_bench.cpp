@@ -16,10 +16,11 @@ void BM_Mlambda(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   std::mt19937_64 rng(42 + static_cast<unsigned>(n));
   std::vector<canyon::rtk::testing::IlsProblem> problems;
+  problems.reserve(16);
   for (int i = 0; i < 16; ++i) problems.push_back(canyon::rtk::testing::gnss_like_problem(n, rng));
   std::size_t next = 0;
   std::int64_t nodes = 0;
-  for (auto _ : state) {
+  for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     const auto& p = problems[next++ % problems.size()];
     auto result = canyon::rtk::mlambda(p.a_float, p.Q_a);
     if (!result) {

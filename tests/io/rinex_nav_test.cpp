@@ -109,13 +109,13 @@ class RinexNavTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   std::string write(const std::string& name, const std::vector<std::string>& lines) {
-    const std::string path = (dir_ / name).string();
+    std::string path = (dir_ / name).string();
     std::ofstream os(path);
     for (const auto& l : lines) os << l << '\n';
     return path;
   }
   std::string write_gzip(const std::string& name, const std::vector<std::string>& lines) {
-    const std::string path = (dir_ / name).string();
+    std::string path = (dir_ / name).string();
     gzFile f = gzopen(path.c_str(), "wb");
     for (const auto& l : lines) {
       gzputs(f, l.c_str());
@@ -300,7 +300,7 @@ TEST_F(RinexNavTest, GzipCutShortIsAnError) {
 TEST_F(RinexNavTest, MissingFileAndGarbageDoNotCrash) {
   EXPECT_FALSE(read_rinex_nav((dir_ / "does_not_exist.nav").string()).ok());
   std::vector<std::string> garbage = kHeader;
-  for (int i = 0; i < 50; ++i) garbage.push_back(std::string(static_cast<std::size_t>(i * 7 % 90), char('!' + i)));
+  for (int i = 0; i < 50; ++i) garbage.emplace_back(static_cast<std::size_t>(i * 7 % 90), char('!' + i));
   EXPECT_FALSE(read_rinex_nav(write("garbage.nav", garbage)).ok());
   std::vector<std::string> short_lines = concat({kHeader, kGps});
   for (std::size_t i = kHeader.size() + 1; i < short_lines.size(); ++i) short_lines[i].resize(10);

@@ -213,7 +213,8 @@ TEST(MlambdaTest, MatchesBruteForceOnIllConditionedLowDimensionalProblems) {
   // Q_a = R diag(lambda) R^T with a random rotation R, condition number 1e3 .. 1e8, enumerated directly in a.
   std::mt19937_64 rng(11);
   for (int n = 2; n <= 3; ++n) {
-    for (double cond = 1e3; cond <= 1e8 * 1.01; cond *= 10.0) {
+    for (int exponent = 3; exponent <= 8; ++exponent) {
+      const double cond = std::pow(10.0, exponent);
       for (int trial = 0; trial < 3; ++trial) {
         const Eigen::HouseholderQR<Eigen::MatrixXd> qr(random_spd(n, 0.0, rng));
         const Eigen::MatrixXd R = qr.householderQ();

@@ -17,7 +17,7 @@ namespace canyon::app {
 class YamlMap {
  public:
   /// `node` must be a map (or null, read as empty); `path` is the key path of the node ("" at the top).
-  YamlMap(YAML::Node node, std::string file, std::string path = {});
+  YamlMap(const YAML::Node& node, std::string file, std::string path = {});
 
   /// Reads `key` into `out` if present (leaves `out` unchanged if absent). Records an error on a type mismatch.
   void get(const std::string& key, double& out);

@@ -31,6 +31,7 @@ struct SatelliteId {
   [[nodiscard]] int index() const;
 
   friend bool operator==(const SatelliteId& a, const SatelliteId& b) = default;
+  // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads a defaulted operator<=>
   friend auto operator<=>(const SatelliteId& a, const SatelliteId& b) = default;
 };
 inline constexpr int kMaxSatellites = 32 + 27 + 36 + 63 + 10;
@@ -49,6 +50,7 @@ struct SignalCode {
   /// "1C".
   [[nodiscard]] std::string to_string() const { return std::string{band, attribute}; }
   friend bool operator==(const SignalCode& a, const SignalCode& b) = default;
+  // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads a defaulted operator<=>
   friend auto operator<=>(const SignalCode& a, const SignalCode& b) = default;
 };
 
