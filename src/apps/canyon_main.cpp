@@ -6,7 +6,6 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include "canyon/app/process.hpp"
@@ -110,9 +109,10 @@ int run_process_command(const ProcessArgs& args) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
   }
-  for (const std::string& w : summary->warnings) spdlog::warn("{}", w);
+  for (const std::string& w : summary->warnings) std::fprintf(stderr, "canyon: warning: %s\n", w.c_str());
   if (args.verbose) {
-    for (const std::string& r : summary->unsolved_reasons) spdlog::info("no solution at {}", r);
+    for (const std::string& r : summary->unsolved_reasons)
+      std::fprintf(stderr, "canyon: no solution at %s\n", r.c_str());
   }
   if (!args.quiet) {
     const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;
@@ -137,7 +137,6 @@ int run_main(int argc, char** argv) {
     app.exit(e);
     return kExitUsage;
   }
-  spdlog::set_pattern("canyon: %l: %v");
   if (app.got_subcommand("process")) return run_process_command(process_args);
   return kExitUsage;
 }

@@ -27,6 +27,7 @@ constexpr double kGloStepS = 60.0;
 constexpr double kDiffStepS = 1e-3;
 constexpr double kBdsGeoInclinationRad = -5.0 * core::kDegToRad;
 constexpr double kMaxAccuracyM = 6144.0;  // largest URA of IS-GPS-200; used when the accuracy is unknown
+constexpr double kUraIndexZeroM = 2.4;    // upper bound of URA index 0 (IS-GPS-200 20.3.3.3.1.3)
 constexpr double kGloErrorM = 5.0;        // GLONASS broadcast orbit/clock error assumed (1 sigma)
 
 struct KeplerParams {
@@ -102,8 +103,16 @@ PositionClock kepler_position_clock(const core::KeplerEphemeris& eph, const GpsT
   return {p_E_m, clock_s};
 }
 
+/// Variance of the broadcast orbit and clock from the accuracy field. 0 is what receivers that store the URA
+/// *index* write for index 0 (the best class, <= 2.4 m; 125 of 162 records of rtklib-test-gsi-2005 carry it), so it
+/// means 2.4 m, not "unknown"; a negative, absurd or beyond-the-table value means no prediction (6144 m).
 double kepler_variance_m2(const core::KeplerEphemeris& eph) {
-  const double acc_m = (eph.accuracy_m > 0.0 && eph.accuracy_m <= kMaxAccuracyM) ? eph.accuracy_m : kMaxAccuracyM;
+  double acc_m = kMaxAccuracyM;
+  if (eph.accuracy_m == 0.0) {
+    acc_m = kUraIndexZeroM;
+  } else if (eph.accuracy_m > 0.0 && eph.accuracy_m <= kMaxAccuracyM) {
+    acc_m = eph.accuracy_m;
+  }
   return acc_m * acc_m;
 }
 
@@ -222,7 +231,8 @@ const core::GlonassEphemeris* EphemerisStore::select_glonass(core::SatelliteId s
   return best;
 }
 
-std::optional<SatelliteState> EphemerisStore::state(core::SatelliteId sat, core::GpsTime t_tx) const {
+std::optional<SatelliteState> EphemerisStore::state(core::SatelliteId sat, core::GpsTime t_tx,
+                                                    bool with_velocity) const {
   SatelliteState s;
   s.sat = sat;
   if (sat.system == Constellation::Glonass) {
@@ -243,11 +253,13 @@ std::optional<SatelliteState> EphemerisStore::state(core::SatelliteId sat, core:
   // Velocity and clock drift by a forward difference over 1 ms: the truncation error (acceleration x step / 2,
   // about 0.3 mm/s) is far below what Doppler can use, and it costs one orbit evaluation instead of two.
   const PositionClock now = kepler_position_clock(*e, t_tx);
-  const PositionClock after = kepler_position_clock(*e, t_tx + kDiffStepS);
   s.p_E_m = now.p_E_m;
-  s.v_E_mps = (after.p_E_m - now.p_E_m) / kDiffStepS;
   s.clock_bias_s = now.clock_s;
-  s.clock_drift_sps = (after.clock_s - now.clock_s) / kDiffStepS;
+  if (with_velocity) {
+    const PositionClock after = kepler_position_clock(*e, t_tx + kDiffStepS);
+    s.v_E_mps = (after.p_E_m - now.p_E_m) / kDiffStepS;
+    s.clock_drift_sps = (after.clock_s - now.clock_s) / kDiffStepS;
+  }
   s.variance_m2 = kepler_variance_m2(*e);
   s.iode = e->iode;
   return s;
@@ -266,7 +278,8 @@ std::optional<double> EphemerisStore::clock_polynomial_s(core::SatelliteId sat, 
 }
 
 std::optional<SatelliteState> EphemerisStore::state_at_reception(core::SatelliteId sat, core::GpsTime t_rx,
-                                                                 double pseudorange_m, core::GpsTime* t_tx) const {
+                                                                 double pseudorange_m, core::GpsTime* t_tx,
+                                                                 bool with_velocity) const {
   // The transmission time needs the satellite clock to ~1e-7 s (3 cm of orbit motion at most); the clock
   // polynomial without the relativistic term (< 5e-8 s) gives that, in two fixed-point steps, without any orbit
   // evaluation. The full state is then computed once.
@@ -277,7 +290,7 @@ std::optional<SatelliteState> EphemerisStore::state_at_reception(core::Satellite
     if (!clock_s) return std::nullopt;
     t = t_signal - *clock_s;
   }
-  auto s = state(sat, t);
+  auto s = state(sat, t, with_velocity);
   if (s && t_tx != nullptr) *t_tx = t;
   return s;
 }

@@ -108,7 +108,8 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
     if (std::find(options.excluded.begin(), options.excluded.end(), sat_obs.sat) != options.excluded.end()) continue;
     const core::SignalObs* signal = select_signal(sat_obs);
     if (signal == nullptr) continue;
-    const auto state = eph.state_at_reception(sat_obs.sat, epoch.time, signal->pseudorange_m);
+    const bool with_velocity = core::has_value(signal->doppler_hz);  // satellite velocity serves Doppler only
+    const auto state = eph.state_at_reception(sat_obs.sat, epoch.time, signal->pseudorange_m, nullptr, with_velocity);
     if (!state) continue;
     const int channel =
         sat_obs.sat.system == Constellation::Glonass ? eph.glonass_channel(sat_obs.sat.prn) : core::kNoGlonassChannel;
@@ -241,9 +242,11 @@ Result<Fix> iterate(const std::vector<Measurement>& ms, const std::vector<bool>&
       if (column >= 0) x[3 + c] += dx[3 + column];
     }
     if (dx.norm() < options.convergence_m) {
+      // Residuals at the solution: after a step this small the linearisation is exact to well below a micrometre
+      // and the elevation mask cannot change the set, so v - H dx replaces another linearisation.
       Fix fix;
-      fix.lin = linearise(ms, active, x, t, eph, options);  // residuals at the solution
-      if (fix.lin.v.size() != lin.v.size()) continue;       // the mask changed the set at the last step: go on
+      lin.v -= lin.H * dx;
+      fix.lin = std::move(lin);
       fix.x = x;
       fix.Q = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
       fix.weighted_sum = fix.lin.v.dot(fix.lin.v.cwiseQuotient(fix.lin.variance));

@@ -10,6 +10,7 @@
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
+#include "canyon/io/number_format.hpp"
 #include "canyon/io/text_reader.hpp"
 
 namespace canyon::io {
@@ -29,7 +30,11 @@ std::string format_time(const core::GpsTime& t, PosTimeFormat format) {
   r.tow_s = std::round(r.tow_s * 1000.0) / 1000.0;
   r = r.normalized();
   if (format == PosTimeFormat::WeekTow) {
-    std::snprintf(buffer, sizeof buffer, "%4d %10.3f", r.week, r.tow_s);
+    std::string out;
+    append_int(out, r.week, 4);
+    out += ' ';
+    append_fixed(out, r.tow_s, 10, 3);
+    return out;
   } else {
     const core::CalendarTime c = core::gps_to_calendar(r);
     std::snprintf(buffer, sizeof buffer, "%04d/%02d/%02d %02d:%02d:%06.3f", c.year, c.month, c.day, c.hour, c.minute,
@@ -69,27 +74,53 @@ Result<PosWriter> PosWriter::create(const std::string& path, PosWriterOptions op
 }
 
 std::string format_pos_record(const core::Solution& s, PosCoordinates coordinates, PosTimeFormat time_format) {
-  char buffer[256];
-  const std::string time = format_time(s.time, time_format);
+  std::string line = format_time(s.time, time_format);
+  line.reserve(160);
+  double sd[6];
   if (coordinates == PosCoordinates::Llh) {
     const core::Geodetic g = core::ecef_to_geodetic(s.p_E_m);
     const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
     const Eigen::Matrix3d P_N = R_NE * s.P_E_m2 * R_NE.transpose();
-    std::snprintf(buffer, sizeof buffer,
-                  "%s %14.9f %14.9f %10.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f", time.c_str(),
-                  g.lat_rad * core::kRadToDeg, g.lon_rad * core::kRadToDeg, g.height_m, static_cast<int>(s.status),
-                  s.num_satellites, std::sqrt(std::max(P_N(1, 1), 0.0)), std::sqrt(std::max(P_N(0, 0), 0.0)),
-                  std::sqrt(std::max(P_N(2, 2), 0.0)), signed_sqrt(P_N(1, 0)), signed_sqrt(P_N(0, 2)),
-                  signed_sqrt(P_N(2, 1)), s.age_s, s.ratio);
+    line += ' ';
+    append_fixed(line, g.lat_rad * core::kRadToDeg, 14, 9);
+    line += ' ';
+    append_fixed(line, g.lon_rad * core::kRadToDeg, 14, 9);
+    line += ' ';
+    append_fixed(line, g.height_m, 10, 4);
+    // sdn sde sdu sdne sdeu sdun
+    sd[0] = std::sqrt(std::max(P_N(1, 1), 0.0));
+    sd[1] = std::sqrt(std::max(P_N(0, 0), 0.0));
+    sd[2] = std::sqrt(std::max(P_N(2, 2), 0.0));
+    sd[3] = signed_sqrt(P_N(1, 0));
+    sd[4] = signed_sqrt(P_N(0, 2));
+    sd[5] = signed_sqrt(P_N(2, 1));
   } else {
     const Eigen::Matrix3d& P = s.P_E_m2;
-    std::snprintf(
-        buffer, sizeof buffer, "%s %14.4f %14.4f %14.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f",
-        time.c_str(), s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z(), static_cast<int>(s.status), s.num_satellites,
-        std::sqrt(std::max(P(0, 0), 0.0)), std::sqrt(std::max(P(1, 1), 0.0)), std::sqrt(std::max(P(2, 2), 0.0)),
-        signed_sqrt(P(0, 1)), signed_sqrt(P(1, 2)), signed_sqrt(P(2, 0)), s.age_s, s.ratio);
+    for (int i = 0; i < 3; ++i) {
+      line += ' ';
+      append_fixed(line, s.p_E_m[i], 14, 4);
+    }
+    // sdx sdy sdz sdxy sdyz sdzx
+    sd[0] = std::sqrt(std::max(P(0, 0), 0.0));
+    sd[1] = std::sqrt(std::max(P(1, 1), 0.0));
+    sd[2] = std::sqrt(std::max(P(2, 2), 0.0));
+    sd[3] = signed_sqrt(P(0, 1));
+    sd[4] = signed_sqrt(P(1, 2));
+    sd[5] = signed_sqrt(P(2, 0));
   }
-  return buffer;
+  line += ' ';
+  append_int(line, static_cast<int>(s.status), 3);
+  line += ' ';
+  append_int(line, s.num_satellites, 3);
+  for (const double v : sd) {
+    line += ' ';
+    append_fixed(line, v, 8, 4);
+  }
+  line += ' ';
+  append_fixed(line, s.age_s, 6, 2);
+  line += ' ';
+  append_fixed(line, s.ratio, 6, 1);
+  return line;
 }
 
 Status PosWriter::write(const core::Solution& solution) {

@@ -99,15 +99,83 @@ std::string_view column(std::string_view line, std::size_t start, std::size_t wi
   return line.substr(start, std::min(width, line.size() - start));
 }
 
+namespace {
+// The blanks of text files; inline rather than std::isspace, a library call per character (hot in RINEX parsing).
+constexpr bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
+}
+}  // namespace
+
 std::string_view trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.remove_suffix(1);
+  while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
+  while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
   return text;
 }
+
+namespace {
+
+constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                             1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+constexpr std::uint64_t kMaxExactMantissa = std::uint64_t{1} << 53;
+
+/// Exact fast path for the numbers RINEX is made of: [+-]digits[.digits][(E|D)[+-]digits]. When the digits form an
+/// integer below 2^53 and the decimal scale is a power of ten that double holds exactly (<= 1e22), the value is one
+/// IEEE division or multiplication of exact operands, hence correctly rounded: the same result as from_chars.
+/// nullopt when the text is not of that form or not in that range (the caller falls back to from_chars).
+std::optional<double> parse_simple_decimal(std::string_view text) {
+  std::size_t i = 0;
+  const bool negative = text[0] == '-';
+  if (text[0] == '-' || text[0] == '+') ++i;
+  std::uint64_t mantissa = 0;
+  int fraction_digits = 0;
+  int digits = 0;
+  bool dot = false;
+  for (; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c >= '0' && c <= '9') {
+      if (++digits > 18) return std::nullopt;
+      mantissa = mantissa * 10 + static_cast<std::uint64_t>(c - '0');
+      if (dot) ++fraction_digits;
+    } else if (c == '.' && !dot) {
+      dot = true;
+    } else {
+      break;
+    }
+  }
+  if (digits == 0 || mantissa >= kMaxExactMantissa) return std::nullopt;
+  int exponent = 0;
+  if (i < text.size()) {
+    if (text[i] != 'E' && text[i] != 'e' && text[i] != 'D' && text[i] != 'd') return std::nullopt;
+    ++i;
+    bool exponent_negative = false;
+    if (i < text.size() && (text[i] == '-' || text[i] == '+')) exponent_negative = text[i++] == '-';
+    if (i == text.size() || text.size() - i > 3) return std::nullopt;
+    for (; i < text.size(); ++i) {
+      if (text[i] < '0' || text[i] > '9') return std::nullopt;
+      exponent = exponent * 10 + (text[i] - '0');
+    }
+    if (exponent_negative) exponent = -exponent;
+  }
+  const int scale = exponent - fraction_digits;
+  double value = static_cast<double>(mantissa);
+  if (scale < 0) {
+    if (-scale > 22) return std::nullopt;
+    value /= kPow10[-scale];
+  } else if (scale > 0) {
+    // m 10^scale is an integer; if the rounded product is below 2^53 the exact one is too, so it is exact.
+    if (scale > 22) return std::nullopt;
+    value *= kPow10[scale];
+    if (value >= static_cast<double>(kMaxExactMantissa)) return std::nullopt;
+  }
+  return negative ? -value : value;
+}
+
+}  // namespace
 
 std::optional<double> parse_double(std::string_view field, std::optional<double> blank_value) {
   field = trim(field);
   if (field.empty()) return blank_value;
+  if (const auto fast = parse_simple_decimal(field)) return fast;
   char buffer[64] = {};
   if (field.size() >= sizeof buffer) return std::nullopt;
   std::size_t n = 0;

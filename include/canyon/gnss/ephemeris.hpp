@@ -54,8 +54,10 @@ class EphemerisStore {
   [[nodiscard]] const core::KeplerEphemeris* select_kepler(core::SatelliteId sat, core::GpsTime t) const;
   [[nodiscard]] const core::GlonassEphemeris* select_glonass(core::SatelliteId sat, core::GpsTime t) const;
 
-  /// Broadcast state of `sat` at GPST transmission time `t_tx`. nullopt if no usable ephemeris.
-  [[nodiscard]] std::optional<SatelliteState> state(core::SatelliteId sat, core::GpsTime t_tx) const;
+  /// Broadcast state of `sat` at GPST transmission time `t_tx`. nullopt if no usable ephemeris. With
+  /// `with_velocity` false, velocity and clock drift of Kepler orbits are left zero (one orbit evaluation less).
+  [[nodiscard]] std::optional<SatelliteState> state(core::SatelliteId sat, core::GpsTime t_tx,
+                                                    bool with_velocity = true) const;
 
   /// Satellite clock polynomial af0 + af1 dt + af2 dt^2 (GLONASS -tau_n + gamma_n dt) at GPST `t`, without the
   /// relativistic term: cheap, for the transmission-time iteration. nullopt if no usable ephemeris.
@@ -64,8 +66,8 @@ class EphemerisStore {
   /// State at the transmission time of a signal received at GPST `t_rx` with pseudorange `pseudorange_m`:
   /// t_tx = t_rx - P / c - dt_sat(t_tx), iterated on the clock polynomial. Writes t_tx if asked.
   [[nodiscard]] std::optional<SatelliteState> state_at_reception(core::SatelliteId sat, core::GpsTime t_rx,
-                                                                 double pseudorange_m,
-                                                                 core::GpsTime* t_tx = nullptr) const;
+                                                                 double pseudorange_m, core::GpsTime* t_tx = nullptr,
+                                                                 bool with_velocity = true) const;
 
   /// Group delay (s) to subtract from a pseudorange on `signal` relative to the system's clock reference:
   /// GPS/QZSS TGD scaled by (f_L1 / f)^2; Galileo BGD(E1,E5a) for F/NAV, BGD(E1,E5b) for I/NAV; BeiDou TGD1/TGD2 on
