@@ -3,13 +3,13 @@
 
 #include "canyon/gnss/spp.hpp"
 
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
+
+#include <gtest/gtest.h>
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
@@ -54,8 +54,8 @@ Scenario make_scenario(const std::array<double, 5>& clock_m) {
         if (!st) break;
         const double range = geometric_range_m(st->p_E_m, s.p_E_true);
         const core::AzEl azel = core::azimuth_elevation(s.p_E_true, rcv, st->p_E_m);
-        const int channel = sat.sat.system == Constellation::Glonass ? s.store->glonass_channel(sat.sat.prn)
-                                                                      : core::kNoGlonassChannel;
+        const int channel =
+            sat.sat.system == Constellation::Glonass ? s.store->glonass_channel(sat.sat.prn) : core::kNoGlonassChannel;
         const double f = core::carrier_frequency_hz(sat.sat.system, sig.code, channel).value_or(1575.42e6);
         const int clock = sat.sat.system == Constellation::Qzss ? 0 : static_cast<int>(sat.sat.system);
         p = range + clock_m[static_cast<std::size_t>(clock)] - core::kSpeedOfLightMps * st->clock_bias_s +

@@ -1,12 +1,12 @@
 // Fast number parsing and formatting agree with the C library on the forms RINEX and .pos use.
 
-#include <gtest/gtest.h>
-
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+
+#include <gtest/gtest.h>
 
 #include "canyon/io/number_format.hpp"
 #include "canyon/io/text_reader.hpp"
