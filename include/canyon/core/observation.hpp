@@ -23,7 +23,9 @@ inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 /// Loss-of-lock indicator bits (RINEX LLI).
 inline constexpr std::uint8_t kLliLossOfLock = 0x01;  ///< lost lock since the previous epoch: cycle slip possible
 inline constexpr std::uint8_t kLliHalfCycle = 0x02;   ///< half-cycle ambiguity not resolved
-inline constexpr std::uint8_t kLliBoc = 0x04;         ///< Galileo BOC-tracking of an MBOC signal
+/// Bit 2 means "BOC tracking of an MBOC signal" in RINEX 3 but "anti-spoofing on" in RINEX 2 (kept as read): RTK acts
+/// on bits 0 and 1 only.
+inline constexpr std::uint8_t kLliBit2 = 0x04;
 
 /// Observables of one signal of one satellite. A missing observable is NaN (use has_value()).
 struct SignalObs {
