@@ -10,6 +10,7 @@
 #include "canyon/gnss/spp.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
+#include "canyon/rtk/engine.hpp"
 
 namespace canyon::app {
 namespace {
@@ -35,6 +36,7 @@ std::vector<std::string> header_lines(const ProcessConfig& config) {
   std::vector<std::string> lines;
   lines.push_back("program   : canyon process (mode " + mode_name(config.mode) + ")");
   lines.push_back("inp file  : " + config.rover_obs);
+  if (config.mode == ProcessMode::Rtk) lines.push_back("inp file  : " + config.base_obs);
   for (const std::string& n : config.nav) lines.push_back("inp file  : " + n);
   char mask[64];
   std::snprintf(mask, sizeof mask, "elev mask : %.1f deg", config.spp.elevation_mask_rad * 57.29577951308232);
@@ -42,6 +44,16 @@ std::vector<std::string> header_lines(const ProcessConfig& config) {
   lines.push_back(std::string("ionos opt : ") + (config.spp.ionosphere_klobuchar ? "Broadcast" : "OFF"));
   lines.push_back(std::string("tropo opt : ") + (config.spp.troposphere_saastamoinen ? "Saastamoinen" : "OFF"));
   return lines;
+}
+
+/// The base epoch to use at rover time t: the latest one not later than t (plus a small tolerance for receivers
+/// whose time tags differ by milliseconds), or nullptr.
+const core::ObsEpoch* base_epoch_at(const std::vector<core::ObsEpoch>& base, std::size_t& cursor,
+                                    const core::GpsTime& t) {
+  constexpr double kToleranceS = 0.05;
+  while (cursor + 1 < base.size() && base[cursor + 1].time - t <= kToleranceS) ++cursor;
+  if (cursor < base.size() && base[cursor].time - t <= kToleranceS) return &base[cursor];
+  return nullptr;
 }
 
 core::Solution to_solution(const gnss::SppSolution& spp) {
@@ -53,6 +65,57 @@ core::Solution to_solution(const gnss::SppSolution& spp) {
   s.v_E_mps = spp.v_E_mps;
   s.num_satellites = spp.num_satellites;
   return s;
+}
+
+void add_unsolved(ProcessSummary& summary, const core::GpsTime& t, const std::string& reason) {
+  if (summary.unsolved_reasons.size() >= kMaxUnsolvedReasons) return;
+  char when[48];
+  std::snprintf(when, sizeof when, "%d %.3f: ", t.week, t.tow_s);
+  summary.unsolved_reasons.push_back(when + reason);
+}
+
+Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
+               const std::vector<core::ObsEpoch>& rover, io::PosWriter& writer, ProcessSummary& summary,
+               const ProgressFn& progress) {
+  std::optional<Eigen::Vector3d> last_p_E;
+  const int total = static_cast<int>(rover.size());
+  for (const core::ObsEpoch& epoch : rover) {
+    ++summary.epochs;
+    auto sol = gnss::solve_spp(epoch, ephemerides, config.spp, last_p_E);
+    if (sol) {
+      last_p_E = sol->p_E_m;
+      if (Status w = writer.write(to_solution(*sol)); !w) return w.error();
+      ++summary.solved;
+    } else {
+      add_unsolved(summary, epoch.time, sol.error().message);
+    }
+    if (progress) progress(summary.epochs, total);
+  }
+  return Ok{};
+}
+
+Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
+               const std::vector<core::ObsEpoch>& rover, const std::vector<core::ObsEpoch>& base,
+               const Eigen::Vector3d& p_E_base, io::PosWriter& writer, ProcessSummary& summary,
+               const ProgressFn& progress) {
+  rtk::RtkOptions options = config.rtk;
+  rtk::RtkEngine engine(options, ephemerides, p_E_base);
+  std::size_t cursor = 0;
+  const int total = static_cast<int>(rover.size());
+  for (const core::ObsEpoch& epoch : rover) {
+    ++summary.epochs;
+    auto result = engine.process(epoch, base_epoch_at(base, cursor, epoch.time));
+    if (result) {
+      if (Status w = writer.write(result->solution); !w) return w.error();
+      ++summary.solved;
+      if (result->solution.status == core::SolutionStatus::Fixed) ++summary.fixed;
+      if (result->solution.status != core::SolutionStatus::Fixed) add_unsolved(summary, epoch.time, result->note);
+    } else {
+      add_unsolved(summary, epoch.time, result.error().message);
+    }
+    if (progress) progress(summary.epochs, total);
+  }
+  return Ok{};
 }
 
 }  // namespace
@@ -70,25 +133,37 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
   if (!rover) return rover.error();
   summary.warnings.insert(summary.warnings.end(), rover->warnings.begin(), rover->warnings.end());
 
+  std::optional<io::RinexObsFile> base;
+  Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
+  if (config.mode == ProcessMode::Rtk) {
+    auto base_file = io::read_rinex_obs(config.base_obs);
+    if (!base_file) return base_file.error();
+    summary.warnings.insert(summary.warnings.end(), base_file->warnings.begin(), base_file->warnings.end());
+    if (config.base_position_E_m) {
+      p_E_base = *config.base_position_E_m;
+    } else if (base_file->header.receiver.approx_position_E_m) {
+      p_E_base = *base_file->header.receiver.approx_position_E_m;
+    } else {
+      return Error{
+          "no base position: the base file has no APPROX POSITION XYZ; give --base-pos X,Y,Z or "
+          "'base_position:'",
+          config.base_obs, 0};
+    }
+    if (!rover->epochs.empty() && !base_file->epochs.empty() &&
+        std::abs(rover->epochs.front().time - base_file->epochs.front().time) > 86400.0 &&
+        std::abs(rover->epochs.back().time - base_file->epochs.back().time) > 86400.0) {
+      summary.warnings.push_back(config.base_obs + ": base observations do not overlap the rover's (another day?)");
+    }
+    base = std::move(*base_file);
+  }
+
   auto writer = io::PosWriter::create(config.out, {config.coordinates, config.time_format, header_lines(config)});
   if (!writer) return writer.error();
-
-  std::optional<Eigen::Vector3d> last_p_E;
-  const int total = static_cast<int>(rover->epochs.size());
-  for (const core::ObsEpoch& epoch : rover->epochs) {
-    ++summary.epochs;
-    auto sol = gnss::solve_spp(epoch, ephemerides, config.spp, last_p_E);
-    if (sol) {
-      last_p_E = sol->p_E_m;
-      if (Status w = writer->write(to_solution(*sol)); !w) return w.error();
-      ++summary.solved;
-    } else if (summary.unsolved_reasons.size() < kMaxUnsolvedReasons) {
-      char when[48];
-      std::snprintf(when, sizeof when, "%d %.3f: ", epoch.time.week, epoch.time.tow_s);
-      summary.unsolved_reasons.push_back(when + sol.error().message);
-    }
-    if (progress) progress(summary.epochs, total);
-  }
+  const Status run =
+      config.mode == ProcessMode::Rtk
+          ? run_rtk(config, ephemerides, rover->epochs, base->epochs, p_E_base, *writer, summary, progress)
+          : run_spp(config, ephemerides, rover->epochs, *writer, summary, progress);
+  if (!run) return run.error();
   if (Status c = writer->close(); !c) return c.error();
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;

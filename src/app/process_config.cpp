@@ -28,28 +28,111 @@ std::vector<std::string> system_letters(const gnss::SppOptions& o) {
   return out;
 }
 
-void parse_spp(YamlMap map, gnss::SppOptions& o) {
-  double mask_deg = o.elevation_mask_rad * core::kRadToDeg;
-  map.get("elevation_mask_deg", mask_deg);
-  o.elevation_mask_rad = mask_deg * core::kDegToRad;
-  std::vector<std::string> systems = system_letters(o);
+std::vector<std::string> system_letters(const rtk::ObservableOptions& o) {
+  std::vector<std::string> out;
+  if (o.use_gps) out.emplace_back("G");
+  if (o.use_glonass) out.emplace_back("R");
+  if (o.use_galileo) out.emplace_back("E");
+  if (o.use_beidou) out.emplace_back("C");
+  if (o.use_qzss) out.emplace_back("J");
+  return out;
+}
+
+/// Reads a list of system letters into the five flags; records an error for anything else.
+void parse_systems(YamlMap& map, std::vector<std::string> systems, bool& gps, bool& glonass, bool& galileo,
+                   bool& beidou, bool& qzss) {
   map.get("systems", systems);
-  o.use_gps = o.use_glonass = o.use_galileo = o.use_beidou = o.use_qzss = false;
+  gps = glonass = galileo = beidou = qzss = false;
   for (const std::string& s : systems) {
     if (s == "G") {
-      o.use_gps = true;
+      gps = true;
     } else if (s == "R") {
-      o.use_glonass = true;
+      glonass = true;
     } else if (s == "E") {
-      o.use_galileo = true;
+      galileo = true;
     } else if (s == "C") {
-      o.use_beidou = true;
+      beidou = true;
     } else if (s == "J") {
-      o.use_qzss = true;
+      qzss = true;
     } else {
       map.fail("systems", "has '" + s + "'; allowed: G, R, E, C, J");
     }
   }
+}
+
+void parse_satellites(YamlMap& map, const std::string& key, std::vector<core::SatelliteId>& out) {
+  std::vector<std::string> texts;
+  for (const auto& sat : out) texts.push_back(sat.to_string());
+  map.get(key, texts);
+  out.clear();
+  for (const std::string& text : texts) {
+    const auto sat = core::parse_satellite(text);
+    if (!sat) {
+      map.fail(key, "has '" + text + "', not a satellite (e.g. G05, R12, E30, C20, J02)");
+    } else {
+      out.push_back(*sat);
+    }
+  }
+}
+
+void parse_angle_deg(YamlMap& map, const std::string& key, double& value_rad) {
+  double deg = value_rad * core::kRadToDeg;
+  map.get(key, deg);
+  value_rad = deg * core::kDegToRad;
+}
+
+void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
+  std::string ar = rtk::ar_mode_name(o.ar_mode);
+  map.get("ar_mode", ar);
+  if (ar == "off") {
+    o.ar_mode = rtk::ArMode::Off;
+  } else if (ar == "continuous") {
+    o.ar_mode = rtk::ArMode::Continuous;
+  } else if (ar == "instantaneous") {
+    o.ar_mode = rtk::ArMode::Instantaneous;
+  } else if (ar == "fix_and_hold") {
+    o.ar_mode = rtk::ArMode::FixAndHold;
+  } else {
+    map.fail("ar_mode", "must be off, continuous, instantaneous or fix_and_hold, not '" + ar + "'");
+  }
+  map.get("frequencies", o.observables.num_frequencies);
+  rtk::ObservableOptions& obs = o.observables;
+  parse_systems(map, system_letters(obs), obs.use_gps, obs.use_glonass, obs.use_galileo, obs.use_beidou, obs.use_qzss);
+  parse_satellites(map, "exclude", obs.excluded);
+  parse_angle_deg(map, "elevation_mask_deg", o.elevation_mask_rad);
+  parse_angle_deg(map, "ar_elevation_mask_deg", o.ar_elevation_mask_rad);
+  map.get("ratio_threshold", o.ratio_threshold);
+  map.get("min_fix_ambiguities", o.min_fix_ambiguities);
+  map.get("min_lock_epochs", o.min_lock_epochs);
+  std::string glonass_ar = o.glonass_ar ? "on" : "off";
+  map.get("glonass_ar", glonass_ar);
+  if (glonass_ar != "on" && glonass_ar != "off" && glonass_ar != "true" && glonass_ar != "false") {
+    map.fail("glonass_ar", "must be on or off, not '" + glonass_ar + "'");
+  }
+  o.glonass_ar = glonass_ar == "on" || glonass_ar == "true";
+  map.get("dynamics", o.dynamics);
+  map.get("accel_sigma_h_mps2", o.accel_sigma_h_mps2);
+  map.get("accel_sigma_v_mps2", o.accel_sigma_v_mps2);
+  map.get("phase_sigma_m", o.phase_sigma_m);
+  map.get("phase_sigma_el_m", o.phase_sigma_el_m);
+  map.get("code_phase_ratio", o.code_phase_ratio);
+  map.get("initial_ambiguity_sigma_cyc", o.initial_ambiguity_sigma_cyc);
+  map.get("ambiguity_noise_cyc", o.ambiguity_noise_cyc);
+  map.get("initial_position_sigma_m", o.initial_position_sigma_m);
+  map.get("max_age_s", o.max_age_s);
+  map.get("max_phase_innovation_m", o.max_phase_innovation_m);
+  map.get("max_code_innovation_m", o.max_code_innovation_m);
+  map.get("hold_sigma_cyc", o.hold_sigma_cyc);
+  map.get("max_outage_s", o.max_outage_s);
+  map.get("slip_gf_threshold_m", o.slip_gf_threshold_m);
+  map.reject_unknown_keys();
+}
+
+void parse_spp(YamlMap map, gnss::SppOptions& o) {
+  double mask_deg = o.elevation_mask_rad * core::kRadToDeg;
+  map.get("elevation_mask_deg", mask_deg);
+  o.elevation_mask_rad = mask_deg * core::kDegToRad;
+  parse_systems(map, system_letters(o), o.use_gps, o.use_glonass, o.use_galileo, o.use_beidou, o.use_qzss);
   std::string iono = o.ionosphere_klobuchar ? "klobuchar" : "off";
   map.get("ionosphere", iono);
   if (iono != "klobuchar" && iono != "off") map.fail("ionosphere", "must be klobuchar or off, not '" + iono + "'");
@@ -64,18 +147,7 @@ void parse_spp(YamlMap map, gnss::SppOptions& o) {
   map.get("raim_fde", o.raim_fde);
   map.get("max_gdop", o.max_gdop);
   map.get("qzss_own_clock", o.qzss_own_clock);
-  std::vector<std::string> excluded;
-  for (const auto& sat : o.excluded) excluded.push_back(sat.to_string());
-  map.get("exclude", excluded);
-  o.excluded.clear();
-  for (const std::string& text : excluded) {
-    const auto sat = core::parse_satellite(text);
-    if (!sat) {
-      map.fail("exclude", "has '" + text + "', not a satellite (e.g. G05, R12, E30, C20, J02)");
-    } else {
-      o.excluded.push_back(*sat);
-    }
-  }
+  parse_satellites(map, "exclude", o.excluded);
   map.reject_unknown_keys();
 }
 
@@ -84,6 +156,7 @@ void parse_spp(YamlMap map, gnss::SppOptions& o) {
 std::string mode_name(ProcessMode mode) {
   switch (mode) {
     case ProcessMode::Spp: return "spp";
+    case ProcessMode::Rtk: return "rtk";
   }
   return "?";
 }
@@ -93,6 +166,10 @@ std::string ProcessConfig::validate() const {
   if (nav.empty()) return "at least one navigation file is required (--nav or 'nav:')";
   if (out.empty()) return "a solution file is required (--out or 'out:')";
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
+  if (mode == ProcessMode::Rtk) {
+    if (base_obs.empty()) return "rtk needs a base observation file (--base or 'base:')";
+    if (const std::string e = rtk.validate(); !e.empty()) return "rtk: " + e;
+  }
   return {};
 }
 
@@ -105,9 +182,35 @@ Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::st
   YamlMap top(node, file);
   std::string mode = mode_name(c.mode);
   top.get("mode", mode);
-  if (mode != "spp") top.fail("mode", "must be spp (rtk and fusion are not available yet), not '" + mode + "'");
+  if (mode == "spp") {
+    c.mode = ProcessMode::Spp;
+  } else if (mode == "rtk") {
+    c.mode = ProcessMode::Rtk;
+  } else {
+    top.fail("mode", "must be spp or rtk (fusion is not available yet), not '" + mode + "'");
+  }
   top.get("rover", c.rover_obs);
   c.rover_obs = resolve(c.rover_obs, file);
+  top.get("base", c.base_obs);
+  c.base_obs = resolve(c.base_obs, file);
+  if (top.has("base_position")) {
+    std::vector<std::string> xyz;
+    top.get("base_position", xyz);
+    std::vector<double> values;
+    for (const std::string& v : xyz) {
+      try {
+        values.push_back(std::stod(v));
+      } catch (const std::exception&) {
+        values.clear();
+        break;
+      }
+    }
+    if (values.size() != 3) {
+      top.fail("base_position", "must be [X, Y, Z], ECEF metres");
+    } else {
+      c.base_position_E_m = Eigen::Vector3d(values[0], values[1], values[2]);
+    }
+  }
   top.get("nav", c.nav);
   for (std::string& n : c.nav) n = resolve(n, file);
   top.get("out", c.out);
@@ -129,9 +232,11 @@ Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::st
     output.reject_unknown_keys();
   }
   parse_spp(top.sub("spp"), c.spp);
+  parse_rtk(top.sub("rtk"), c.rtk);
   top.reject_unknown_keys();
   if (Status s = top.status(); !s) return s.error();
   if (const std::string e = c.spp.validate(); !e.empty()) return Error{"spp: " + e, file, 0};
+  if (const std::string e = c.rtk.validate(); !e.empty()) return Error{"rtk: " + e, file, 0};
   return c;
 }
 
@@ -141,11 +246,48 @@ Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig
   return parse_process_config(*node, path, std::move(defaults));
 }
 
+static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
+  out << YAML::Key << "rtk" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "ar_mode" << YAML::Value << rtk::ar_mode_name(o.ar_mode);
+  out << YAML::Key << "frequencies" << YAML::Value << o.observables.num_frequencies;
+  out << YAML::Key << "systems" << YAML::Value << YAML::Flow << system_letters(o.observables);
+  std::vector<std::string> excluded;
+  for (const auto& sat : o.observables.excluded) excluded.push_back(sat.to_string());
+  out << YAML::Key << "exclude" << YAML::Value << YAML::Flow << excluded;
+  out << YAML::Key << "elevation_mask_deg" << YAML::Value << o.elevation_mask_rad * core::kRadToDeg;
+  out << YAML::Key << "ar_elevation_mask_deg" << YAML::Value << o.ar_elevation_mask_rad * core::kRadToDeg;
+  out << YAML::Key << "ratio_threshold" << YAML::Value << o.ratio_threshold;
+  out << YAML::Key << "min_fix_ambiguities" << YAML::Value << o.min_fix_ambiguities;
+  out << YAML::Key << "min_lock_epochs" << YAML::Value << o.min_lock_epochs;
+  out << YAML::Key << "glonass_ar" << YAML::Value << (o.glonass_ar ? "on" : "off");
+  out << YAML::Key << "dynamics" << YAML::Value << o.dynamics;
+  out << YAML::Key << "accel_sigma_h_mps2" << YAML::Value << o.accel_sigma_h_mps2;
+  out << YAML::Key << "accel_sigma_v_mps2" << YAML::Value << o.accel_sigma_v_mps2;
+  out << YAML::Key << "phase_sigma_m" << YAML::Value << o.phase_sigma_m;
+  out << YAML::Key << "phase_sigma_el_m" << YAML::Value << o.phase_sigma_el_m;
+  out << YAML::Key << "code_phase_ratio" << YAML::Value << o.code_phase_ratio;
+  out << YAML::Key << "initial_ambiguity_sigma_cyc" << YAML::Value << o.initial_ambiguity_sigma_cyc;
+  out << YAML::Key << "ambiguity_noise_cyc" << YAML::Value << o.ambiguity_noise_cyc;
+  out << YAML::Key << "initial_position_sigma_m" << YAML::Value << o.initial_position_sigma_m;
+  out << YAML::Key << "max_age_s" << YAML::Value << o.max_age_s;
+  out << YAML::Key << "max_phase_innovation_m" << YAML::Value << o.max_phase_innovation_m;
+  out << YAML::Key << "max_code_innovation_m" << YAML::Value << o.max_code_innovation_m;
+  out << YAML::Key << "hold_sigma_cyc" << YAML::Value << o.hold_sigma_cyc;
+  out << YAML::Key << "max_outage_s" << YAML::Value << o.max_outage_s;
+  out << YAML::Key << "slip_gf_threshold_m" << YAML::Value << o.slip_gf_threshold_m;
+  out << YAML::EndMap;
+}
+
 std::string to_yaml(const ProcessConfig& c) {
   YAML::Emitter out;
   out << YAML::BeginMap;
   out << YAML::Key << "mode" << YAML::Value << mode_name(c.mode);
   out << YAML::Key << "rover" << YAML::Value << c.rover_obs;
+  out << YAML::Key << "base" << YAML::Value << c.base_obs;
+  if (c.base_position_E_m) {
+    out << YAML::Key << "base_position" << YAML::Value << YAML::Flow << YAML::BeginSeq << c.base_position_E_m->x()
+        << c.base_position_E_m->y() << c.base_position_E_m->z() << YAML::EndSeq;
+  }
   out << YAML::Key << "nav" << YAML::Value << YAML::Flow << c.nav;
   out << YAML::Key << "out" << YAML::Value << c.out;
   out << YAML::Key << "output" << YAML::Value << YAML::BeginMap;
@@ -167,6 +309,7 @@ std::string to_yaml(const ProcessConfig& c) {
   for (const auto& sat : s.excluded) excluded.push_back(sat.to_string());
   out << YAML::Key << "exclude" << YAML::Value << YAML::Flow << excluded;
   out << YAML::EndMap;
+  emit_rtk(out, c.rtk);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

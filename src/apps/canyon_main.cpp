@@ -11,6 +11,7 @@
 #include "canyon/app/process.hpp"
 #include "canyon/app/process_config.hpp"
 #include "canyon/core/constants.hpp"
+#include "canyon/core/satellite.hpp"
 
 namespace {
 
@@ -43,6 +44,9 @@ struct ProcessArgs {
   std::string config_file;
   std::string mode;
   std::string rover;
+  std::string base;
+  std::string base_pos;
+  std::string exclude_sats;
   std::vector<std::string> nav;
   std::string out;
   std::string coordinates;
@@ -57,8 +61,11 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   CLI::App* cmd = app.add_subcommand("process", "Process recorded observations into a solution file (.pos)");
   cmd->add_option("--config", args.config_file, "YAML configuration (strict: unknown keys are errors)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--mode", args.mode, "Processing mode: spp")->check(CLI::IsMember({"spp"}));
+  cmd->add_option("--mode", args.mode, "Processing mode: spp or rtk")->check(CLI::IsMember({"spp", "rtk"}));
   cmd->add_option("--rover", args.rover, "Rover RINEX observation file (2.x/3.x, may be gzip-compressed)");
+  cmd->add_option("--base", args.base, "Base RINEX observation file (rtk)");
+  cmd->add_option("--base-pos", args.base_pos, "Base antenna ECEF X,Y,Z in metres (default: base file header)");
+  cmd->add_option("--exclude-sats", args.exclude_sats, "Satellites never used, e.g. G05,E11");
   cmd->add_option("--nav", args.nav, "RINEX navigation file (repeat for several)");
   cmd->add_option("--out", args.out, "Solution file, RTKLIB .pos format");
   cmd->add_option("--coordinates", args.coordinates, "Output coordinates: llh or ecef")
@@ -83,7 +90,37 @@ int run_process_command(const ProcessArgs& args) {
     }
     config = std::move(*loaded);
   }
+  if (!args.mode.empty()) {
+    config.mode = args.mode == "rtk" ? canyon::app::ProcessMode::Rtk : canyon::app::ProcessMode::Spp;
+  }
   if (!args.rover.empty()) config.rover_obs = args.rover;
+  if (!args.base.empty()) config.base_obs = args.base;
+  if (!args.base_pos.empty()) {
+    double x = 0, y = 0, z = 0;
+    char tail = 0;
+    if (std::sscanf(args.base_pos.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &tail) != 3) {
+      std::cerr << "canyon: error: --base-pos must be X,Y,Z (ECEF metres), not '" << args.base_pos << "'\n";
+      return kExitUsage;
+    }
+    config.base_position_E_m = Eigen::Vector3d(x, y, z);
+  }
+  if (!args.exclude_sats.empty()) {
+    std::vector<canyon::core::SatelliteId> excluded;
+    std::string item;
+    for (std::size_t start = 0; start <= args.exclude_sats.size();) {
+      const std::size_t comma = std::min(args.exclude_sats.find(',', start), args.exclude_sats.size());
+      item = args.exclude_sats.substr(start, comma - start);
+      const auto sat = canyon::core::parse_satellite(item);
+      if (!sat) {
+        std::cerr << "canyon: error: --exclude-sats: '" << item << "' is not a satellite (e.g. G05,E11)\n";
+        return kExitUsage;
+      }
+      excluded.push_back(*sat);
+      start = comma + 1;
+    }
+    config.spp.excluded = excluded;
+    config.rtk.observables.excluded = excluded;
+  }
   if (!args.nav.empty()) config.nav = args.nav;
   if (!args.out.empty()) config.out = args.out;
   if (!args.coordinates.empty()) {
@@ -116,8 +153,15 @@ int run_process_command(const ProcessArgs& args) {
   }
   if (!args.quiet) {
     const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;
-    std::fprintf(stderr, "canyon process: %d epochs, %d solved (%.1f %%), %.2f s wall, solution: %s\n", summary->epochs,
-                 summary->solved, percent, summary->wall_s, config.out.c_str());
+    std::string fixed;
+    if (config.mode == canyon::app::ProcessMode::Rtk) {
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, ", %d fixed (%.1f %%)", summary->fixed,
+                    summary->epochs > 0 ? 100.0 * summary->fixed / summary->epochs : 0.0);
+      fixed = buffer;
+    }
+    std::fprintf(stderr, "canyon process: %d epochs, %d solved (%.1f %%)%s, %.2f s wall, solution: %s\n",
+                 summary->epochs, summary->solved, percent, fixed.c_str(), summary->wall_s, config.out.c_str());
   }
   return summary->solved > 0 ? 0 : kExitInput;
 }

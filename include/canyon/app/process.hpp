@@ -13,6 +13,7 @@ namespace canyon::app {
 struct ProcessSummary {
   int epochs = 0;                             ///< rover epochs read
   int solved = 0;                             ///< epochs with a solution written
+  int fixed = 0;                              ///< epochs with a fixed (RTK) solution
   double wall_s = 0.0;                        ///< wall-clock time of the whole run
   std::vector<std::string> warnings;          ///< recovered input defects, "file:line: what"
   std::vector<std::string> unsolved_reasons;  ///< one line per unsolved epoch, "week tow: reason" (first 100)

@@ -3,8 +3,10 @@
 // file and/or the command line. Relative paths in a YAML file are relative to that file's folder.
 //
 // YAML keys (all optional; the command line overrides them):
-//   mode: spp                      # processing mode (spp; rtk and fusion come with later modules)
+//   mode: spp                      # processing mode: spp | rtk (fusion comes with a later module)
 //   rover: ROVER.obs               # rover RINEX observations (2.x/3.x, may be .gz)
+//   base: BASE.obs                 # base RINEX observations (rtk)
+//   base_position: [X, Y, Z]       # base antenna ECEF (m); default: the base file's APPROX POSITION XYZ
 //   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
 //   out: SOL.pos                   # solution file (RTKLIB .pos format)
 //   output:
@@ -20,7 +22,9 @@
 //     max_gdop: 30                 # reject solutions with a larger GDOP
 //     qzss_own_clock: false        # false: QZSS shares the GPS receiver clock
 //     exclude: [G05]               # satellites never used
+//   rtk:                           # see config/rtk.yaml for every key with its unit and default
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,19 +33,23 @@
 #include "canyon/core/result.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/io/pos_file.hpp"
+#include "canyon/rtk/engine.hpp"
 
 namespace canyon::app {
 
-enum class ProcessMode { Spp };
+enum class ProcessMode { Spp, Rtk };
 
 struct ProcessConfig {
   ProcessMode mode = ProcessMode::Spp;
-  std::string rover_obs;         ///< rover observation file
-  std::vector<std::string> nav;  ///< navigation files
-  std::string out;               ///< solution file
+  std::string rover_obs;                             ///< rover observation file
+  std::string base_obs;                              ///< base observation file (rtk)
+  std::optional<Eigen::Vector3d> base_position_E_m;  ///< base antenna position (ECEF, m); header position if unset
+  std::vector<std::string> nav;                      ///< navigation files
+  std::string out;                                   ///< solution file
   io::PosCoordinates coordinates = io::PosCoordinates::Llh;
   io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
   gnss::SppOptions spp;
+  rtk::RtkOptions rtk;
 
   /// Empty if complete and consistent, else the first violated rule ("rover observation file is required").
   [[nodiscard]] std::string validate() const;

@@ -1,0 +1,135 @@
+#pragma once
+// Kinematic RTK: an extended Kalman filter over the rover position and single-differenced carrier-phase
+// ambiguities, double-differenced code and phase measurements, and MLAMBDA integer ambiguity resolution.
+//
+// State x = [p_E_u (3) | v_E_u, a_E_u (6, with dynamics) | N_sd (one per (satellite, frequency), cycles)], where
+// N_sd = N_rover - N_base. Ambiguities are keyed by (satellite, frequency rank): added when both receivers track the
+// pair, reset on a cycle slip or after an outage, removed when lost.
+//
+// Measurements, per group g = (constellation, frequency) with reference satellite r (highest elevation) and
+// every other satellite s of the group, in metres:
+//   DD phase: (lambda_s Phi_sd,s - lambda_r Phi_sd,r) = DD rho(p_E_u) + lambda_s N_sd,s - lambda_r N_sd,r + e
+//   DD code:  (P_sd,s - P_sd,r)                       = DD rho(p_E_u) + e
+// with SD = rover - base, rho the geometric range with the Sagnac term, minus the satellite clock, plus the
+// Saastamoinen troposphere at each receiver (computed per receiver at its own transmission time, so that receivers
+// whose time tags differ by milliseconds difference correctly). Receiver clocks cancel in the double differences;
+// for short baselines the differential ionosphere is neglected. Zero-difference variance per receiver:
+//   sigma_phase^2 = a^2 + b^2 / sin^2(el),  sigma_code = code_phase_ratio * sigma_phase.
+// The DD covariance follows from the SD variances (correlated through the reference satellite).
+//
+// Time update: without dynamics (RTKLIB's "dynamics off") the position is re-initialised each epoch from the
+// single-point solution with a large variance; with dynamics a constant-acceleration model with white jerk.
+// Ambiguities carry over with a small random walk.
+//
+// Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA, ratio test; the fixed position
+// from the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix). Modes: continuous, instantaneous (ambiguities
+// re-initialised every epoch), fix-and-hold (the fixed DD ambiguities fed back as pseudo-measurements with a small
+// variance). GLONASS ambiguities are fixed only when glonass_ar is on.
+
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/observation.hpp"
+#include "canyon/core/result.hpp"
+#include "canyon/core/solution.hpp"
+#include "canyon/gnss/ephemeris.hpp"
+#include "canyon/gnss/spp.hpp"
+#include "canyon/rtk/observables.hpp"
+
+namespace canyon::rtk {
+
+struct SingleDiff;  // one (satellite, frequency) rover-base single difference (engine.cpp)
+
+enum class ArMode { Off, Continuous, Instantaneous, FixAndHold };
+
+struct RtkOptions {
+  ObservableOptions observables;            ///< systems, number of frequencies (1..3), excluded satellites
+  ArMode ar_mode = ArMode::Continuous;
+  double elevation_mask_rad = 15.0 * 0.017453292519943295;     ///< satellites below are not used
+  double ar_elevation_mask_rad = 15.0 * 0.017453292519943295;  ///< ambiguities below are not fixed
+  bool dynamics = false;                    ///< constant-acceleration model; false: position from SPP each epoch
+  double accel_sigma_h_mps2 = 3.0;          ///< horizontal acceleration noise (m/s^2 per sqrt(s)) with dynamics
+  double accel_sigma_v_mps2 = 1.0;          ///< vertical acceleration noise with dynamics
+  double phase_sigma_m = 0.003;             ///< a: zenith-independent phase noise (m)
+  double phase_sigma_el_m = 0.003;          ///< b: elevation-dependent phase noise (m), divided by sin(el)
+  double code_phase_ratio = 100.0;          ///< code sigma / phase sigma
+  double initial_ambiguity_sigma_cyc = 30.0;     ///< sigma of a new ambiguity (cycles)
+  double ambiguity_noise_cyc = 1e-4;             ///< ambiguity random walk (cycles per sqrt(s))
+  double initial_position_sigma_m = 30.0;        ///< sigma of the SPP position used as prior (m)
+  double ratio_threshold = 3.0;             ///< ratio test threshold (the paper's 3.0)
+  int min_fix_ambiguities = 4;              ///< fewer DD ambiguities are not fixed
+  int min_lock_epochs = 0;                  ///< epochs an ambiguity must be tracked before it is fixed
+  bool glonass_ar = false;                  ///< fix GLONASS ambiguities (needs equal inter-frequency biases)
+  double max_age_s = 30.0;                  ///< base observations older than this are not used
+  double max_phase_innovation_m = 30.0;     ///< DD phase innovations beyond are rejected as outliers
+  double max_code_innovation_m = 100.0;     ///< DD code innovations beyond are rejected as outliers
+  double hold_sigma_cyc = 0.001;            ///< fix-and-hold pseudo-measurement sigma (cycles)
+  double max_outage_s = 5.0;                ///< an ambiguity not observed for longer is re-initialised
+  double slip_gf_threshold_m = 0.05;        ///< geometry-free phase jump counted as a cycle slip (m)
+  gnss::SppOptions spp;                     ///< single-point solution (prior and fallback)
+
+  /// Empty if valid, else the violated rule.
+  [[nodiscard]] std::string validate() const;
+};
+
+/// One epoch's result.
+struct RtkEpoch {
+  core::Solution solution;        ///< status Fixed, Float or Single
+  int num_fixed_ambiguities = 0;  ///< DD ambiguities in the accepted fix (0 if not fixed)
+  int num_dd_measurements = 0;    ///< DD phase measurements used in the update
+  std::vector<core::SatelliteId> rejected;  ///< satellites whose measurements failed the innovation gate
+  std::string note;               ///< why the epoch is not fixed, if it is not (for --verbose)
+};
+
+/// The RTK filter. Feed rover epochs in time order with the base epoch to use (nullptr if none).
+class RtkEngine {
+ public:
+  RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides, Eigen::Vector3d p_E_base_m);
+
+  /// Processes one rover epoch. Error only if not even a single-point solution exists.
+  Result<RtkEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base);
+
+ private:
+  using AmbiguityKey = std::pair<core::SatelliteId, int>;  // (satellite, frequency rank)
+  struct AmbiguityInfo {
+    int lock_epochs = 0;
+    core::GpsTime last_seen;
+    double gf_m = core::kNoValue;  // last geometry-free combination (rover - base SD), for slip detection
+  };
+  void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
+  [[nodiscard]] std::vector<SingleDiff> single_differences(const core::ObsEpoch& rover,
+                                                           const core::ObsEpoch& base) const;
+  void detect_slips(const std::vector<SingleDiff>& sds, const core::GpsTime& t);
+  void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
+  /// EKF update with the DD code and phase; returns the number of DD phase rows used.
+  int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
+  /// MLAMBDA and the ratio test; fills the fixed solution of `out` and returns true when fixed.
+  bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
+  void add_ambiguity(const AmbiguityKey& key, double value_cyc);
+  void remove_ambiguity(const AmbiguityKey& key);
+  [[nodiscard]] int ambiguity_index(const AmbiguityKey& key) const;
+  [[nodiscard]] int num_kinematic_states() const { return options_.dynamics ? 9 : 3; }
+
+  RtkOptions options_;
+  const gnss::EphemerisStore& eph_;
+  Eigen::Vector3d p_E_base_m_;
+  Eigen::VectorXd x_;
+  Eigen::MatrixXd P_;
+  std::vector<AmbiguityKey> ambiguity_keys_;  // state index = num_kinematic_states() + position in this list
+  std::map<AmbiguityKey, AmbiguityInfo> ambiguity_info_;
+  std::optional<core::GpsTime> last_time_;
+  bool initialised_ = false;
+  std::optional<Eigen::Vector3d> last_spp_p_E_m_;
+  std::map<core::SatelliteId, std::pair<double, core::GpsTime>> gf_by_satellite_;  // last SD geometry-free (m)
+
+  friend class RtkEngineAccess;  // tests
+};
+
+[[nodiscard]] const char* ar_mode_name(ArMode mode);
+
+}  // namespace canyon::rtk

@@ -1,0 +1,502 @@
+// Kinematic RTK filter (model and state layout in engine.hpp).
+
+#include "canyon/rtk/engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/core/geodesy.hpp"
+#include "canyon/gnss/atmosphere.hpp"
+#include "canyon/rtk/lambda.hpp"
+
+namespace canyon::rtk {
+namespace {
+
+using core::Constellation;
+using core::SatelliteId;
+
+constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
+constexpr double kGfSlipMaxGapS = 60.0;      // beyond this the ionosphere can move the GF combination too much
+constexpr double kCodeInitVarianceFactor = 1.0;  // a new ambiguity's variance also covers the code noise
+
+/// Zero-difference model of one satellite seen from one receiver.
+struct ZeroDiff {
+  bool valid = false;
+  double model_m = 0.0;              // rho (Sagnac) - c dts + troposphere
+  Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  // unit vector receiver -> satellite
+  double elevation_rad = 0.0;
+};
+
+ZeroDiff zero_difference(const gnss::EphemerisStore& eph, const SatelliteId sat, const core::GpsTime& t_rx,
+                         double pseudorange_m, const Eigen::Vector3d& p_E, const core::Geodetic& g) {
+  ZeroDiff z;
+  const auto state = eph.state_at_reception(sat, t_rx, pseudorange_m, nullptr, false);
+  if (!state) return z;
+  const double range_m = gnss::geometric_range_m(state->p_E_m, p_E, &z.los_E);
+  const core::AzEl azel = core::azimuth_elevation(p_E, g, state->p_E_m);
+  z.elevation_rad = azel.elevation_rad;
+  z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s + gnss::saastamoinen_delay_m(g, azel.elevation_rad);
+  z.valid = true;
+  return z;
+}
+
+/// Pseudorange of a satellite for the transmission-time computation: the first frequency that has one.
+double any_pseudorange(const ReceiverObservables& obs, SatelliteId sat) {
+  for (int f = 0; f < kMaxFrequencies; ++f) {
+    if (const SignalObservable* s = obs.find(sat, f); s != nullptr && core::has_value(s->pseudorange_m)) {
+      return s->pseudorange_m;
+    }
+  }
+  return core::kNoValue;
+}
+
+
+double zero_diff_phase_variance(const RtkOptions& o, double elevation_rad) {
+  const double sin_el = std::max(std::sin(elevation_rad), 0.05);
+  return o.phase_sigma_m * o.phase_sigma_m + o.phase_sigma_el_m * o.phase_sigma_el_m / (sin_el * sin_el);
+}
+
+/// A linear(ised) DD measurement row: h = H x, innovation v, and which SDs it differences.
+struct DdRow {
+  Eigen::RowVectorXd H;
+  double innovation_m = 0.0;
+  int sd = -1;         // index into the SD list of satellite s
+  int reference = -1;  // index of the reference satellite's SD
+  bool phase = true;
+};
+
+}  // namespace
+
+/// One single-differenced (rover - base) observable ready for double differencing.
+struct SingleDiff {
+  SatelliteId sat;
+  int frequency = 0;
+  int group = 0;  // constellation * kMaxFrequencies + frequency
+  double wavelength_m = 0.0;
+  double phase_m = core::kNoValue;  // lambda (Phi_r - Phi_b) - (model_r - model_b)
+  double code_m = core::kNoValue;   // (P_r - P_b) - (model_r - model_b)
+  double phase_variance_m2 = 0.0;
+  double code_variance_m2 = 0.0;
+  Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  // rover line of sight
+  double elevation_rad = 0.0;
+  std::uint8_t lli = 0;  // rover | base loss-of-lock bits
+  int ambiguity = -1;    // state index of N_sd, -1 if none
+  bool fixable = false;
+};
+
+const char* ar_mode_name(ArMode mode) {
+  switch (mode) {
+    case ArMode::Off: return "off";
+    case ArMode::Continuous: return "continuous";
+    case ArMode::Instantaneous: return "instantaneous";
+    case ArMode::FixAndHold: return "fix_and_hold";
+  }
+  return "?";
+}
+
+std::string RtkOptions::validate() const {
+  if (observables.num_frequencies < 1 || observables.num_frequencies > kMaxFrequencies) {
+    return "frequencies must be 1, 2 or 3";
+  }
+  if (!(elevation_mask_rad >= 0.0 && elevation_mask_rad < core::kPi / 2.0)) {
+    return "elevation_mask_rad must be in [0, pi/2)";
+  }
+  if (!(ratio_threshold >= 1.0)) return "ratio_threshold must be >= 1";
+  if (min_fix_ambiguities < 1) return "min_fix_ambiguities must be >= 1";
+  if (!(phase_sigma_m > 0.0) || !(code_phase_ratio > 0.0)) return "phase_sigma_m and code_phase_ratio must be > 0";
+  if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
+  if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
+  if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";
+  if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
+  return {};
+}
+
+RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides, Eigen::Vector3d p_E_base_m)
+    : options_(std::move(options)), eph_(ephemerides), p_E_base_m_(std::move(p_E_base_m)) {
+  x_ = Eigen::VectorXd::Zero(num_kinematic_states());
+  P_ = Eigen::MatrixXd::Zero(num_kinematic_states(), num_kinematic_states());
+}
+
+int RtkEngine::ambiguity_index(const AmbiguityKey& key) const {
+  const auto it = std::find(ambiguity_keys_.begin(), ambiguity_keys_.end(), key);
+  return it == ambiguity_keys_.end() ? -1 : num_kinematic_states() + static_cast<int>(it - ambiguity_keys_.begin());
+}
+
+void RtkEngine::add_ambiguity(const AmbiguityKey& key, double value_cyc) {
+  const auto n = x_.size();
+  x_.conservativeResize(n + 1);
+  x_[n] = value_cyc;
+  P_.conservativeResize(n + 1, n + 1);
+  P_.row(n).setZero();
+  P_.col(n).setZero();
+  P_(n, n) = options_.initial_ambiguity_sigma_cyc * options_.initial_ambiguity_sigma_cyc;
+  ambiguity_keys_.push_back(key);
+}
+
+void RtkEngine::remove_ambiguity(const AmbiguityKey& key) {
+  const int index = ambiguity_index(key);
+  if (index < 0) return;
+  const auto n = x_.size();
+  const auto tail = n - index - 1;
+  x_.segment(index, tail) = x_.tail(tail).eval();
+  x_.conservativeResize(n - 1);
+  P_.block(index, 0, tail, n) = P_.bottomRows(tail).eval();
+  P_.block(0, index, n, tail) = P_.rightCols(tail).eval();
+  P_.conservativeResize(n - 1, n - 1);
+  ambiguity_keys_.erase(ambiguity_keys_.begin() + (index - num_kinematic_states()));
+  ambiguity_info_.erase(key);
+}
+
+void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp) {
+  const double dt_s = last_time_ ? std::abs(t - *last_time_) : 0.0;
+  const double var0 = options_.initial_position_sigma_m * options_.initial_position_sigma_m;
+  const int k = num_kinematic_states();
+  if (!options_.dynamics || !initialised_ || dt_s > 30.0) {
+    // Position (and velocity, acceleration) from the single-point solution, uncorrelated with the ambiguities.
+    P_.topRows(k).setZero();
+    P_.leftCols(k).setZero();
+    x_.head<3>() = spp.p_E_m;
+    P_.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * var0;
+    if (options_.dynamics) {
+      x_.segment<3>(3) = spp.v_E_mps.value_or(Eigen::Vector3d::Zero());
+      x_.segment<3>(6).setZero();
+      P_.block<3, 3>(3, 3) = Eigen::Matrix3d::Identity() * 100.0;
+      P_.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * 100.0;
+    }
+    initialised_ = true;
+  } else {
+    // Constant acceleration: x' = F x, P' = F P F^T + Q with white jerk of the given spectral density (ENU).
+    Eigen::MatrixXd F = Eigen::MatrixXd::Identity(x_.size(), x_.size());
+    for (int i = 0; i < 3; ++i) {
+      F(i, 3 + i) = dt_s;
+      F(i, 6 + i) = 0.5 * dt_s * dt_s;
+      F(3 + i, 6 + i) = dt_s;
+    }
+    x_ = F * x_;
+    P_ = F * P_ * F.transpose();
+    const core::Geodetic g = core::ecef_to_geodetic(x_.head<3>());
+    const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(g).transpose();
+    Eigen::Matrix3d Q_N = Eigen::Matrix3d::Zero();
+    Q_N(0, 0) = Q_N(1, 1) = options_.accel_sigma_h_mps2 * options_.accel_sigma_h_mps2 * dt_s;
+    Q_N(2, 2) = options_.accel_sigma_v_mps2 * options_.accel_sigma_v_mps2 * dt_s;
+    P_.block<3, 3>(6, 6) += R_EN * Q_N * R_EN.transpose();
+  }
+  // Ambiguities: random walk.
+  const double q = options_.ambiguity_noise_cyc * options_.ambiguity_noise_cyc * dt_s;
+  for (Eigen::Index i = k; i < x_.size(); ++i) P_(i, i) += q;
+  last_time_ = t;
+}
+
+
+void RtkEngine::detect_slips(const std::vector<SingleDiff>& sds, const core::GpsTime& t) {
+  for (const SingleDiff& sd : sds) {
+    if (!core::has_value(sd.phase_m)) continue;
+    const AmbiguityKey key{sd.sat, sd.frequency};
+    const auto info = ambiguity_info_.find(key);
+    if (info == ambiguity_info_.end()) continue;
+    bool slip = (sd.lli & core::kLliLossOfLock) != 0;
+    if (t - info->second.last_seen > options_.max_outage_s) slip = true;
+    if (slip) remove_ambiguity(key);
+  }
+  // Geometry-free combination of the SD phases (model terms cancel): a jump is a slip on one of the two
+  // frequencies of one of the receivers, which cannot be told apart, so both ambiguities are reset.
+  for (const SingleDiff& sd : sds) {
+    if (sd.frequency != 0 || !core::has_value(sd.phase_m)) continue;
+    const SingleDiff* second = nullptr;
+    for (const SingleDiff& other : sds) {
+      if (other.sat == sd.sat && other.frequency > 0 && core::has_value(other.phase_m)) {
+        second = &other;
+        break;
+      }
+    }
+    if (second == nullptr) continue;
+    const double gf_m = sd.phase_m - second->phase_m;
+    auto& last = gf_by_satellite_[sd.sat];
+    if (core::has_value(last.first) && t - last.second < kGfSlipMaxGapS &&
+        std::abs(gf_m - last.first) > options_.slip_gf_threshold_m) {
+      remove_ambiguity({sd.sat, 0});
+      remove_ambiguity({sd.sat, second->frequency});
+    }
+    last = {gf_m, t};
+  }
+}
+
+void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t) {
+  // Remove ambiguities not seen for longer than the outage limit.
+  std::vector<AmbiguityKey> stale;
+  for (const auto& [key, info] : ambiguity_info_) {
+    if (t - info.last_seen > options_.max_outage_s) stale.push_back(key);
+  }
+  for (const auto& key : stale) remove_ambiguity(key);
+  for (SingleDiff& sd : sds) {
+    if (!core::has_value(sd.phase_m)) continue;
+    const AmbiguityKey key{sd.sat, sd.frequency};
+    if (ambiguity_index(key) < 0) {
+      if (!core::has_value(sd.code_m)) continue;
+      add_ambiguity(key, (sd.phase_m - sd.code_m) / sd.wavelength_m);
+      ambiguity_info_[key] = AmbiguityInfo{};
+    }
+    AmbiguityInfo& a = ambiguity_info_[key];
+    a.last_seen = t;
+    ++a.lock_epochs;
+    const bool half_cycle = (sd.lli & core::kLliHalfCycle) != 0;
+    const bool glonass_ok = sd.sat.system != Constellation::Glonass || options_.glonass_ar;
+    sd.fixable = !half_cycle && glonass_ok && a.lock_epochs > options_.min_lock_epochs &&
+                 sd.elevation_rad >= options_.ar_elevation_mask_rad;
+  }
+  for (SingleDiff& sd : sds) {
+    sd.ambiguity = core::has_value(sd.phase_m) ? ambiguity_index({sd.sat, sd.frequency}) : -1;
+  }
+}
+
+int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected) {
+  // Group by (constellation, frequency); the reference is the highest satellite with the observable.
+  const Eigen::Index n = x_.size();
+  std::vector<DdRow> rows;
+  std::map<int, std::vector<int>> groups;
+  for (int i = 0; i < static_cast<int>(sds.size()); ++i) groups[sds[static_cast<std::size_t>(i)].group].push_back(i);
+  for (const bool phase : {true, false}) {
+    for (const auto& [group, members] : groups) {
+      int reference = -1;
+      for (const int i : members) {
+        const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+        const bool usable = phase ? sd.ambiguity >= 0 : core::has_value(sd.code_m);
+        if (usable && (reference < 0 || sd.elevation_rad > sds[static_cast<std::size_t>(reference)].elevation_rad)) {
+          reference = i;
+        }
+      }
+      if (reference < 0) continue;
+      const SingleDiff& ref = sds[static_cast<std::size_t>(reference)];
+      for (const int i : members) {
+        const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+        if (i == reference || (phase ? sd.ambiguity < 0 : !core::has_value(sd.code_m))) continue;
+        DdRow row;
+        row.phase = phase;
+        row.sd = i;
+        row.reference = reference;
+        row.H = Eigen::RowVectorXd::Zero(n);
+        row.H.head<3>() = -(sd.los_E - ref.los_E).transpose();
+        double predicted_m = 0.0;
+        double observed_m = 0.0;
+        if (phase) {
+          row.H[sd.ambiguity] = sd.wavelength_m;
+          row.H[ref.ambiguity] = -ref.wavelength_m;
+          predicted_m = sd.wavelength_m * x_[sd.ambiguity] - ref.wavelength_m * x_[ref.ambiguity];
+          observed_m = sd.phase_m - ref.phase_m;
+        } else {
+          observed_m = sd.code_m - ref.code_m;
+        }
+        // The SD residuals were formed at the prior position: the geometry term is already in observed_m, and
+        // the position correction enters through H; at the prior, the predicted DD range residual is zero.
+        row.innovation_m = observed_m - predicted_m;
+        const double gate = phase ? options_.max_phase_innovation_m : options_.max_code_innovation_m;
+        if (std::abs(row.innovation_m) > gate) {
+          rejected.push_back(sd.sat);
+          continue;
+        }
+        rows.push_back(std::move(row));
+      }
+    }
+  }
+  if (rows.empty()) return 0;
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd H(m, n);
+  Eigen::VectorXd v(m);
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    const DdRow& ra = rows[static_cast<std::size_t>(a)];
+    H.row(a) = ra.H;
+    v[a] = ra.innovation_m;
+    const auto variance = [&](int i) {
+      const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+      return ra.phase ? sd.phase_variance_m2 : sd.code_variance_m2;
+    };
+    R(a, a) = variance(ra.sd) + variance(ra.reference);
+    for (Eigen::Index b = 0; b < a; ++b) {
+      const DdRow& rb = rows[static_cast<std::size_t>(b)];
+      if (rb.phase == ra.phase && rb.reference == ra.reference) R(a, b) = R(b, a) = variance(ra.reference);
+    }
+  }
+  // Kalman update: K = P H^T (H P H^T + R)^-1.
+  const Eigen::MatrixXd PHt = P_ * H.transpose();
+  const Eigen::MatrixXd S = H * PHt + R;
+  const Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success) return 0;
+  x_ += PHt * llt.solve(v);
+  P_ -= PHt * llt.solve(PHt.transpose());
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  int phase_rows = 0;
+  for (const DdRow& r : rows) phase_rows += r.phase ? 1 : 0;
+  return phase_rows;
+}
+
+bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out) {
+  // DD ambiguities of the fixable SDs against each group's highest fixable satellite.
+  std::map<int, int> reference;  // group -> SD index
+  for (int i = 0; i < static_cast<int>(sds.size()); ++i) {
+    const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+    if (!sd.fixable || sd.ambiguity < 0) continue;
+    auto it = reference.find(sd.group);
+    if (it == reference.end() || sd.elevation_rad > sds[static_cast<std::size_t>(it->second)].elevation_rad) {
+      reference[sd.group] = i;
+    }
+  }
+  std::vector<std::pair<int, int>> dd;  // (state index of s, state index of reference)
+  for (int i = 0; i < static_cast<int>(sds.size()); ++i) {
+    const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+    if (!sd.fixable || sd.ambiguity < 0) continue;
+    const int r = reference.at(sd.group);
+    if (r == i) continue;
+    dd.emplace_back(sd.ambiguity, sds[static_cast<std::size_t>(r)].ambiguity);
+  }
+  const auto nd = static_cast<Eigen::Index>(dd.size());
+  if (nd < options_.min_fix_ambiguities) {
+    out.note = "too few ambiguities to fix: " + std::to_string(nd);
+    return false;
+  }
+  const Eigen::Index n = x_.size();
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(nd, n);
+  for (Eigen::Index k = 0; k < nd; ++k) {
+    D(k, dd[static_cast<std::size_t>(k)].first) = 1.0;
+    D(k, dd[static_cast<std::size_t>(k)].second) = -1.0;
+  }
+  const Eigen::VectorXd a_float = D * x_;
+  const Eigen::MatrixXd PDt = P_ * D.transpose();
+  Eigen::MatrixXd Q_a = D * PDt;
+  Q_a = 0.5 * (Q_a + Q_a.transpose()).eval();
+  auto search = mlambda(a_float, Q_a);
+  if (!search) {
+    out.note = "integer search failed: " + search.error().message;
+    return false;
+  }
+  const RatioTestOutcome ratio = ratio_test(*search, options_.ratio_threshold);
+  out.solution.ratio = std::min(ratio.ratio, 999.9);
+  if (!ratio.passed) {
+    out.note = "ratio test failed";
+    return false;
+  }
+  // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix).
+  const Eigen::VectorXd a_fix = search->candidates.col(0);
+  const Eigen::LLT<Eigen::MatrixXd> llt(Q_a);
+  if (llt.info() != Eigen::Success) {
+    out.note = "float ambiguity covariance not positive definite";
+    return false;
+  }
+  const Eigen::VectorXd x_fix = x_ - PDt * llt.solve(a_float - a_fix);
+  const Eigen::MatrixXd P_fix = P_ - PDt * llt.solve(PDt.transpose());
+  out.solution.p_E_m = x_fix.head<3>();
+  out.solution.P_E_m2 = P_fix.topLeftCorner<3, 3>();
+  out.solution.status = core::SolutionStatus::Fixed;
+  out.num_fixed_ambiguities = static_cast<int>(nd);
+  if (options_.ar_mode == ArMode::FixAndHold) {
+    // Hold: the fixed DD ambiguities as pseudo-measurements with a small variance, into the float filter.
+    const double var = options_.hold_sigma_cyc * options_.hold_sigma_cyc;
+    const Eigen::MatrixXd S = Q_a + var * Eigen::MatrixXd::Identity(nd, nd);
+    const Eigen::LLT<Eigen::MatrixXd> hold(S);
+    x_ -= PDt * hold.solve(a_float - a_fix);
+    P_ -= PDt * hold.solve(PDt.transpose());
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+  }
+  return true;
+}
+
+Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+  auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_);
+  if (!spp) return spp.error();
+  last_spp_p_E_m_ = spp->p_E_m;
+
+  RtkEpoch out;
+  core::Solution& sol = out.solution;
+  sol.time = spp->time;
+  sol.status = core::SolutionStatus::Single;
+  sol.p_E_m = spp->p_E_m;
+  sol.P_E_m2 = spp->P_E_m2;
+  sol.v_E_mps = spp->v_E_mps;
+  sol.num_satellites = spp->num_satellites;
+  if (base == nullptr) {
+    out.note = "no base observations";
+    return out;
+  }
+  const double age_s = rover.time - base->time;
+  sol.age_s = age_s;
+  if (age_s > options_.max_age_s || age_s < -kMaxBaseTimeAheadS) {
+    out.note = "base observations too old (age " + std::to_string(age_s) + " s)";
+    return out;
+  }
+
+  if (options_.ar_mode == ArMode::Instantaneous) {
+    while (!ambiguity_keys_.empty()) remove_ambiguity(ambiguity_keys_.back());
+    gf_by_satellite_.clear();
+  }
+  time_update(rover.time, *spp);
+  std::vector<SingleDiff> sds = single_differences(rover, *base);
+  detect_slips(sds, rover.time);
+  update_ambiguities(sds, rover.time);
+  out.num_dd_measurements = measurement_update(sds, out.rejected);
+  if (out.num_dd_measurements == 0) {
+    out.note = "no double-differenced phase";
+    return out;
+  }
+  sol.status = core::SolutionStatus::Float;
+  sol.p_E_m = x_.head<3>();
+  sol.P_E_m2 = P_.topLeftCorner<3, 3>();
+  int satellites = 0;
+  for (std::size_t i = 0; i < sds.size(); ++i) {
+    if (sds[i].frequency == 0 || (i > 0 && sds[i - 1].sat != sds[i].sat)) ++satellites;
+  }
+  sol.num_satellites = satellites;
+  if (options_.ar_mode != ArMode::Off) resolve_ambiguities(sds, out);
+  return out;
+}
+
+std::vector<SingleDiff> RtkEngine::single_differences(const core::ObsEpoch& rover, const core::ObsEpoch& base) const {
+  const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
+  const ReceiverObservables base_obs = select_observables(base, eph_, options_.observables);
+  const Eigen::Vector3d p_E_u = x_.head<3>();
+  const core::Geodetic g_u = core::ecef_to_geodetic(p_E_u);
+  const core::Geodetic g_b = core::ecef_to_geodetic(p_E_base_m_);
+  std::vector<SingleDiff> sds;
+  sds.reserve(rover_obs.signals.size());
+  SatelliteId current{};
+  ZeroDiff zr;
+  ZeroDiff zb;
+  for (const SignalObservable& r : rover_obs.signals) {
+    const SignalObservable* b = base_obs.find(r.sat, r.frequency);
+    if (b == nullptr) continue;
+    if (r.sat != current || sds.empty()) {
+      // Each receiver's geometry at its own transmission time (its own time tag and pseudorange).
+      current = r.sat;
+      const double pr_r = any_pseudorange(rover_obs, r.sat);
+      const double pr_b = any_pseudorange(base_obs, r.sat);
+      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover.time, pr_r, p_E_u, g_u) : ZeroDiff{};
+      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base.time, pr_b, p_E_base_m_, g_b) : ZeroDiff{};
+    }
+    if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
+    SingleDiff sd;
+    sd.sat = r.sat;
+    sd.frequency = r.frequency;
+    sd.group = static_cast<int>(r.sat.system) * kMaxFrequencies + r.frequency;
+    sd.wavelength_m = r.wavelength_m;
+    sd.lli = static_cast<std::uint8_t>(r.lli | b->lli);
+    const double model_m = zr.model_m - zb.model_m;
+    if (core::has_value(r.carrier_phase_cyc) && core::has_value(b->carrier_phase_cyc) &&
+        std::abs(r.wavelength_m - b->wavelength_m) < 1e-9) {
+      sd.phase_m = r.wavelength_m * (r.carrier_phase_cyc - b->carrier_phase_cyc) - model_m;
+    }
+    if (core::has_value(r.pseudorange_m) && core::has_value(b->pseudorange_m)) {
+      sd.code_m = (r.pseudorange_m - b->pseudorange_m) - model_m;
+    }
+    const double var_zd = zero_diff_phase_variance(options_, zr.elevation_rad);
+    sd.phase_variance_m2 = 2.0 * var_zd;
+    sd.code_variance_m2 = 2.0 * var_zd * options_.code_phase_ratio * options_.code_phase_ratio;
+    sd.los_E = zr.los_E;
+    sd.elevation_rad = zr.elevation_rad;
+    sds.push_back(sd);
+  }
+  return sds;
+}
+
+}  // namespace canyon::rtk
