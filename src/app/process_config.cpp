@@ -104,6 +104,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("ratio_threshold", o.ratio_threshold);
   map.get("min_fix_ambiguities", o.min_fix_ambiguities);
   map.get("min_lock_epochs", o.min_lock_epochs);
+  map.get("partial_ar", o.partial_ar);
   std::string glonass_ar = o.glonass_ar ? "on" : "off";
   map.get("glonass_ar", glonass_ar);
   if (glonass_ar != "on" && glonass_ar != "off" && glonass_ar != "true" && glonass_ar != "false") {
@@ -125,6 +126,18 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("hold_sigma_cyc", o.hold_sigma_cyc);
   map.get("max_outage_s", o.max_outage_s);
   map.get("slip_gf_threshold_m", o.slip_gf_threshold_m);
+  std::string tropo = o.troposphere_saastamoinen ? "saastamoinen" : "off";
+  map.get("troposphere", tropo);
+  if (tropo != "saastamoinen" && tropo != "off") {
+    map.fail("troposphere", "must be saastamoinen or off, not '" + tropo + "'");
+  }
+  o.troposphere_saastamoinen = tropo == "saastamoinen";
+  std::string iono = o.ionosphere == rtk::IonosphereModel::Estimate ? "estimate" : "off";
+  map.get("ionosphere", iono);
+  if (iono != "estimate" && iono != "off") map.fail("ionosphere", "must be off or estimate, not '" + iono + "'");
+  o.ionosphere = iono == "estimate" ? rtk::IonosphereModel::Estimate : rtk::IonosphereModel::Off;
+  map.get("iono_sigma_per_10km_m", o.iono_sigma_per_10km_m);
+  map.get("iono_noise_m", o.iono_noise_m);
   map.reject_unknown_keys();
 }
 
@@ -259,6 +272,7 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "ratio_threshold" << YAML::Value << o.ratio_threshold;
   out << YAML::Key << "min_fix_ambiguities" << YAML::Value << o.min_fix_ambiguities;
   out << YAML::Key << "min_lock_epochs" << YAML::Value << o.min_lock_epochs;
+  out << YAML::Key << "partial_ar" << YAML::Value << o.partial_ar;
   out << YAML::Key << "glonass_ar" << YAML::Value << (o.glonass_ar ? "on" : "off");
   out << YAML::Key << "dynamics" << YAML::Value << o.dynamics;
   out << YAML::Key << "accel_sigma_h_mps2" << YAML::Value << o.accel_sigma_h_mps2;
@@ -275,6 +289,11 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "hold_sigma_cyc" << YAML::Value << o.hold_sigma_cyc;
   out << YAML::Key << "max_outage_s" << YAML::Value << o.max_outage_s;
   out << YAML::Key << "slip_gf_threshold_m" << YAML::Value << o.slip_gf_threshold_m;
+  out << YAML::Key << "troposphere" << YAML::Value << (o.troposphere_saastamoinen ? "saastamoinen" : "off");
+  out << YAML::Key << "ionosphere" << YAML::Value
+      << (o.ionosphere == rtk::IonosphereModel::Estimate ? "estimate" : "off");
+  out << YAML::Key << "iono_sigma_per_10km_m" << YAML::Value << o.iono_sigma_per_10km_m;
+  out << YAML::Key << "iono_noise_m" << YAML::Value << o.iono_noise_m;
   out << YAML::EndMap;
 }
 

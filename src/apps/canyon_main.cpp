@@ -146,7 +146,15 @@ int run_process_command(const ProcessArgs& args) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
   }
-  for (const std::string& w : summary->warnings) std::fprintf(stderr, "canyon: warning: %s\n", w.c_str());
+  // Input defects are often repeated every epoch: show the first few and count the rest.
+  constexpr std::size_t kMaxWarningsShown = 5;
+  for (std::size_t i = 0; i < summary->warnings.size() && (args.verbose || i < kMaxWarningsShown); ++i) {
+    std::fprintf(stderr, "canyon: warning: %s\n", summary->warnings[i].c_str());
+  }
+  if (!args.verbose && summary->warnings.size() > kMaxWarningsShown) {
+    std::fprintf(stderr, "canyon: warning: ... and %zu more input warnings (-v shows all)\n",
+                 summary->warnings.size() - kMaxWarningsShown);
+  }
   if (args.verbose) {
     for (const std::string& r : summary->unsolved_reasons)
       std::fprintf(stderr, "canyon: no solution at %s\n", r.c_str());

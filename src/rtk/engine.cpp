@@ -18,29 +18,37 @@ namespace {
 using core::Constellation;
 using core::SatelliteId;
 
-constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
-constexpr double kGfSlipMaxGapS = 60.0;      // beyond this the ionosphere can move the GF combination too much
+constexpr double kMaxBaseTimeAheadS = 0.05;      // base tags up to this much after the rover tag still count as "now"
+constexpr double kGfSlipMaxGapS = 60.0;          // beyond this the ionosphere can move the GF combination too much
 constexpr double kCodeInitVarianceFactor = 1.0;  // a new ambiguity's variance also covers the code noise
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {
   bool valid = false;
-  double model_m = 0.0;              // rho (Sagnac) - c dts + troposphere
+  double model_m = 0.0;                             // rho (Sagnac) - c dts + troposphere
   Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  // unit vector receiver -> satellite
   double elevation_rad = 0.0;
 };
 
 ZeroDiff zero_difference(const gnss::EphemerisStore& eph, const SatelliteId sat, const core::GpsTime& t_rx,
-                         double pseudorange_m, const Eigen::Vector3d& p_E, const core::Geodetic& g) {
+                         double pseudorange_m, const Eigen::Vector3d& p_E, const core::Geodetic& g, bool troposphere) {
   ZeroDiff z;
   const auto state = eph.state_at_reception(sat, t_rx, pseudorange_m, nullptr, false);
   if (!state) return z;
   const double range_m = gnss::geometric_range_m(state->p_E_m, p_E, &z.los_E);
   const core::AzEl azel = core::azimuth_elevation(p_E, g, state->p_E_m);
   z.elevation_rad = azel.elevation_rad;
-  z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s + gnss::saastamoinen_delay_m(g, azel.elevation_rad);
+  z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s +
+              (troposphere ? gnss::saastamoinen_delay_m(g, azel.elevation_rad) : 0.0);
   z.valid = true;
   return z;
+}
+
+/// Wavelength of a satellite's first frequency (rank 0), the reference of the ionosphere state.
+double first_wavelength_m(const gnss::EphemerisStore& eph, SatelliteId sat) {
+  const char band = sat.system == Constellation::BeiDou ? '2' : '1';
+  const int channel = sat.system == Constellation::Glonass ? eph.glonass_channel(sat.prn) : core::kNoGlonassChannel;
+  return core::wavelength_m(sat.system, core::SignalCode{band, 'C'}, channel).value_or(0.19029367279836487);
 }
 
 /// Pseudorange of a satellite for the transmission-time computation: the first frequency that has one.
@@ -52,7 +60,6 @@ double any_pseudorange(const ReceiverObservables& obs, SatelliteId sat) {
   }
   return core::kNoValue;
 }
-
 
 double zero_diff_phase_variance(const RtkOptions& o, double elevation_rad) {
   const double sin_el = std::max(std::sin(elevation_rad), 0.05);
@@ -82,8 +89,10 @@ struct SingleDiff {
   double code_variance_m2 = 0.0;
   Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  // rover line of sight
   double elevation_rad = 0.0;
-  std::uint8_t lli = 0;  // rover | base loss-of-lock bits
-  int ambiguity = -1;    // state index of N_sd, -1 if none
+  std::uint8_t lli = 0;     // rover | base loss-of-lock bits
+  int ambiguity = -1;       // state index of N_sd, -1 if none
+  int iono = -1;            // state index of the satellite's SD ionosphere, -1 if not estimated
+  double iono_scale = 1.0;  // (f_1 / f)^2: the delay on this frequency per metre of first-frequency delay
   bool fixable = false;
 };
 
@@ -125,14 +134,14 @@ int RtkEngine::ambiguity_index(const AmbiguityKey& key) const {
   return it == ambiguity_keys_.end() ? -1 : num_kinematic_states() + static_cast<int>(it - ambiguity_keys_.begin());
 }
 
-void RtkEngine::add_ambiguity(const AmbiguityKey& key, double value_cyc) {
+void RtkEngine::add_ambiguity(const AmbiguityKey& key, double value, double variance) {
   const auto n = x_.size();
   x_.conservativeResize(n + 1);
-  x_[n] = value_cyc;
+  x_[n] = value;
   P_.conservativeResize(n + 1, n + 1);
   P_.row(n).setZero();
   P_.col(n).setZero();
-  P_(n, n) = options_.initial_ambiguity_sigma_cyc * options_.initial_ambiguity_sigma_cyc;
+  P_(n, n) = variance;
   ambiguity_keys_.push_back(key);
 }
 
@@ -184,12 +193,14 @@ void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp
     Q_N(2, 2) = options_.accel_sigma_v_mps2 * options_.accel_sigma_v_mps2 * dt_s;
     P_.block<3, 3>(6, 6) += R_EN * Q_N * R_EN.transpose();
   }
-  // Ambiguities: random walk.
-  const double q = options_.ambiguity_noise_cyc * options_.ambiguity_noise_cyc * dt_s;
-  for (Eigen::Index i = k; i < x_.size(); ++i) P_(i, i) += q;
+  // Ambiguities and ionosphere: random walks.
+  const double q_amb = options_.ambiguity_noise_cyc * options_.ambiguity_noise_cyc * dt_s;
+  const double q_iono = options_.iono_noise_m * options_.iono_noise_m * dt_s;
+  for (Eigen::Index i = k; i < x_.size(); ++i) {
+    P_(i, i) += ambiguity_keys_[static_cast<std::size_t>(i - k)].second == kIonoKey ? q_iono : q_amb;
+  }
   last_time_ = t;
 }
-
 
 void RtkEngine::detect_slips(const std::vector<SingleDiff>& sds, const core::GpsTime& t) {
   for (const SingleDiff& sd : sds) {
@@ -236,7 +247,8 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     const AmbiguityKey key{sd.sat, sd.frequency};
     if (ambiguity_index(key) < 0) {
       if (!core::has_value(sd.code_m)) continue;
-      add_ambiguity(key, (sd.phase_m - sd.code_m) / sd.wavelength_m);
+      const double sigma = options_.initial_ambiguity_sigma_cyc;
+      add_ambiguity(key, (sd.phase_m - sd.code_m) / sd.wavelength_m, sigma * sigma);
       ambiguity_info_[key] = AmbiguityInfo{};
     }
     AmbiguityInfo& a = ambiguity_info_[key];
@@ -247,8 +259,18 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     sd.fixable = !half_cycle && glonass_ok && a.lock_epochs > options_.min_lock_epochs &&
                  sd.elevation_rad >= options_.ar_elevation_mask_rad;
   }
+  if (options_.ionosphere == IonosphereModel::Estimate) {
+    const double baseline_10km = (x_.head<3>() - p_E_base_m_).norm() / 1e4;
+    const double sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, 0.001);
+    for (const SingleDiff& sd : sds) {
+      const AmbiguityKey key{sd.sat, kIonoKey};
+      if (ambiguity_index(key) < 0) add_ambiguity(key, 0.0, sigma_m * sigma_m);
+      ambiguity_info_[key].last_seen = t;
+    }
+  }
   for (SingleDiff& sd : sds) {
     sd.ambiguity = core::has_value(sd.phase_m) ? ambiguity_index({sd.sat, sd.frequency}) : -1;
+    sd.iono = ambiguity_index({sd.sat, kIonoKey});
   }
 }
 
@@ -288,6 +310,13 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
           observed_m = sd.phase_m - ref.phase_m;
         } else {
           observed_m = sd.code_m - ref.code_m;
+        }
+        if (sd.iono >= 0 && ref.iono >= 0) {
+          // The ionosphere advances phase and delays code by iono_scale * I_sd.
+          const double sign = phase ? -1.0 : 1.0;
+          row.H[sd.iono] += sign * sd.iono_scale;
+          row.H[ref.iono] -= sign * ref.iono_scale;
+          predicted_m += sign * (sd.iono_scale * x_[sd.iono] - ref.iono_scale * x_[ref.iono]);
         }
         // The SD residuals were formed at the prior position: the geometry term is already in observed_m, and
         // the position correction enters through H; at the prior, the predicted DD range residual is zero.
@@ -333,71 +362,108 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
   return phase_rows;
 }
 
-bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out) {
-  // DD ambiguities of the fixable SDs against each group's highest fixable satellite.
+namespace {
+
+/// DD ambiguities (state index of s, state index of its group's reference) of the fixable SDs of the groups not
+/// excluded; the reference of each group is its highest fixable satellite.
+std::vector<std::pair<int, int>> dd_ambiguities(const std::vector<SingleDiff>& sds, int excluded_group) {
   std::map<int, int> reference;  // group -> SD index
   for (int i = 0; i < static_cast<int>(sds.size()); ++i) {
     const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
-    if (!sd.fixable || sd.ambiguity < 0) continue;
+    if (!sd.fixable || sd.ambiguity < 0 || sd.group == excluded_group) continue;
     auto it = reference.find(sd.group);
     if (it == reference.end() || sd.elevation_rad > sds[static_cast<std::size_t>(it->second)].elevation_rad) {
       reference[sd.group] = i;
     }
   }
-  std::vector<std::pair<int, int>> dd;  // (state index of s, state index of reference)
+  std::vector<std::pair<int, int>> dd;
   for (int i = 0; i < static_cast<int>(sds.size()); ++i) {
     const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
-    if (!sd.fixable || sd.ambiguity < 0) continue;
+    if (!sd.fixable || sd.ambiguity < 0 || sd.group == excluded_group) continue;
     const int r = reference.at(sd.group);
-    if (r == i) continue;
-    dd.emplace_back(sd.ambiguity, sds[static_cast<std::size_t>(r)].ambiguity);
+    if (r != i) dd.emplace_back(sd.ambiguity, sds[static_cast<std::size_t>(r)].ambiguity);
   }
+  return dd;
+}
+
+}  // namespace
+
+std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int, int>>& dd) const {
   const auto nd = static_cast<Eigen::Index>(dd.size());
-  if (nd < options_.min_fix_ambiguities) {
-    out.note = "too few ambiguities to fix: " + std::to_string(nd);
-    return false;
-  }
-  const Eigen::Index n = x_.size();
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(nd, n);
+  if (nd < options_.min_fix_ambiguities) return std::nullopt;
+  Fix fix;
+  fix.D = Eigen::MatrixXd::Zero(nd, x_.size());
   for (Eigen::Index k = 0; k < nd; ++k) {
-    D(k, dd[static_cast<std::size_t>(k)].first) = 1.0;
-    D(k, dd[static_cast<std::size_t>(k)].second) = -1.0;
+    fix.D(k, dd[static_cast<std::size_t>(k)].first) = 1.0;
+    fix.D(k, dd[static_cast<std::size_t>(k)].second) = -1.0;
   }
-  const Eigen::VectorXd a_float = D * x_;
-  const Eigen::MatrixXd PDt = P_ * D.transpose();
-  Eigen::MatrixXd Q_a = D * PDt;
-  Q_a = 0.5 * (Q_a + Q_a.transpose()).eval();
-  auto search = mlambda(a_float, Q_a);
-  if (!search) {
-    out.note = "integer search failed: " + search.error().message;
+  fix.a_float = fix.D * x_;
+  fix.PDt = P_ * fix.D.transpose();
+  fix.Q_a = fix.D * fix.PDt;
+  fix.Q_a = 0.5 * (fix.Q_a + fix.Q_a.transpose()).eval();
+  auto search = mlambda(fix.a_float, fix.Q_a);
+  if (!search) return std::nullopt;
+  fix.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
+  fix.squared_norm = search->squared_norms[0];
+  fix.a_fix = search->candidates.col(0);
+  return fix;
+}
+
+bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out) {
+  const auto all = dd_ambiguities(sds, -1);
+  if (static_cast<int>(all.size()) < options_.min_fix_ambiguities) {
+    out.note = "too few ambiguities to fix: " + std::to_string(all.size());
     return false;
   }
-  const RatioTestOutcome ratio = ratio_test(*search, options_.ratio_threshold);
-  out.solution.ratio = std::min(ratio.ratio, 999.9);
-  if (!ratio.passed) {
+  std::optional<Fix> best = try_fix(all);
+  if (best) out.solution.ratio = std::min(best->ratio, 999.9);
+  if ((!best || best->ratio < options_.ratio_threshold) && !options_.partial_ar) {
     out.note = "ratio test failed";
     return false;
   }
+  if (!best || best->ratio < options_.ratio_threshold) {
+    // Partial fixing: one (constellation, frequency) group whose ambiguities are not integers (e.g. signals that two
+    // receivers track differently) must not spoil the others: retry without each group, keep the best that passes.
+    std::map<int, bool> groups;
+    for (const SingleDiff& sd : sds) {
+      if (sd.fixable && sd.ambiguity >= 0) groups[sd.group] = true;
+    }
+    std::optional<Fix> partial;
+    for (const auto& [group, unused] : groups) {
+      (void)unused;
+      auto candidate = try_fix(dd_ambiguities(sds, group));
+      if (candidate && candidate->ratio >= options_.ratio_threshold &&
+          (!partial || candidate->ratio > partial->ratio)) {
+        partial = std::move(candidate);
+      }
+    }
+    if (!partial) {
+      out.note = "ratio test failed";
+      return false;
+    }
+    best = std::move(partial);
+    out.solution.ratio = std::min(best->ratio, 999.9);
+  }
   // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix).
-  const Eigen::VectorXd a_fix = search->candidates.col(0);
-  const Eigen::LLT<Eigen::MatrixXd> llt(Q_a);
+  const Eigen::LLT<Eigen::MatrixXd> llt(best->Q_a);
   if (llt.info() != Eigen::Success) {
     out.note = "float ambiguity covariance not positive definite";
     return false;
   }
-  const Eigen::VectorXd x_fix = x_ - PDt * llt.solve(a_float - a_fix);
-  const Eigen::MatrixXd P_fix = P_ - PDt * llt.solve(PDt.transpose());
+  const Eigen::VectorXd x_fix = x_ - best->PDt * llt.solve(best->a_float - best->a_fix);
+  const Eigen::MatrixXd P_fix = P_ - best->PDt * llt.solve(best->PDt.transpose());
   out.solution.p_E_m = x_fix.head<3>();
   out.solution.P_E_m2 = P_fix.topLeftCorner<3, 3>();
   out.solution.status = core::SolutionStatus::Fixed;
-  out.num_fixed_ambiguities = static_cast<int>(nd);
+  out.num_fixed_ambiguities = static_cast<int>(best->a_fix.size());
   if (options_.ar_mode == ArMode::FixAndHold) {
     // Hold: the fixed DD ambiguities as pseudo-measurements with a small variance, into the float filter.
     const double var = options_.hold_sigma_cyc * options_.hold_sigma_cyc;
-    const Eigen::MatrixXd S = Q_a + var * Eigen::MatrixXd::Identity(nd, nd);
+    const auto nd = best->a_fix.size();
+    const Eigen::MatrixXd S = best->Q_a + var * Eigen::MatrixXd::Identity(nd, nd);
     const Eigen::LLT<Eigen::MatrixXd> hold(S);
-    x_ -= PDt * hold.solve(a_float - a_fix);
-    P_ -= PDt * hold.solve(PDt.transpose());
+    x_ -= best->PDt * hold.solve(best->a_float - best->a_fix);
+    P_ -= best->PDt * hold.solve(best->PDt.transpose());
     P_ = 0.5 * (P_ + P_.transpose()).eval();
   }
   return true;
@@ -458,6 +524,7 @@ std::vector<SingleDiff> RtkEngine::single_differences(const core::ObsEpoch& rove
   const Eigen::Vector3d p_E_u = x_.head<3>();
   const core::Geodetic g_u = core::ecef_to_geodetic(p_E_u);
   const core::Geodetic g_b = core::ecef_to_geodetic(p_E_base_m_);
+  const bool tropo = options_.troposphere_saastamoinen;
   std::vector<SingleDiff> sds;
   sds.reserve(rover_obs.signals.size());
   SatelliteId current{};
@@ -471,8 +538,8 @@ std::vector<SingleDiff> RtkEngine::single_differences(const core::ObsEpoch& rove
       current = r.sat;
       const double pr_r = any_pseudorange(rover_obs, r.sat);
       const double pr_b = any_pseudorange(base_obs, r.sat);
-      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover.time, pr_r, p_E_u, g_u) : ZeroDiff{};
-      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base.time, pr_b, p_E_base_m_, g_b) : ZeroDiff{};
+      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover.time, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
+      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base.time, pr_b, p_E_base_m_, g_b, tropo) : ZeroDiff{};
     }
     if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
     SingleDiff sd;
@@ -480,6 +547,7 @@ std::vector<SingleDiff> RtkEngine::single_differences(const core::ObsEpoch& rove
     sd.frequency = r.frequency;
     sd.group = static_cast<int>(r.sat.system) * kMaxFrequencies + r.frequency;
     sd.wavelength_m = r.wavelength_m;
+    sd.iono_scale = std::pow(r.wavelength_m / first_wavelength_m(eph_, r.sat), 2);
     sd.lli = static_cast<std::uint8_t>(r.lli | b->lli);
     const double model_m = zr.model_m - zb.model_m;
     if (core::has_value(r.carrier_phase_cyc) && core::has_value(b->carrier_phase_cyc) &&

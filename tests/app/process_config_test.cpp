@@ -30,10 +30,39 @@ TEST(ProcessConfigTest, EveryShippedConfigLoads) {
   EXPECT_GE(loaded, 2);
 }
 
-TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFile) {
+TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {
   auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/spp.yaml");
   ASSERT_TRUE(config.ok()) << config.error().to_string();
   EXPECT_EQ(*config, ProcessConfig{});
+  auto rtk = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/rtk.yaml");
+  ASSERT_TRUE(rtk.ok()) << rtk.error().to_string();
+  ProcessConfig expected;
+  expected.mode = ProcessMode::Rtk;
+  EXPECT_EQ(to_yaml(*rtk), to_yaml(expected));
+}
+
+TEST(ProcessConfigTest, RtkOptionsParseAndRoundTrip) {
+  auto config = parse(R"(
+mode: rtk
+base: /data/base.obs
+base_position: [-3959400.631, 3385704.533, 3667523.111]
+rtk: {ar_mode: fix_and_hold, frequencies: 1, systems: [G, R], glonass_ar: on, ionosphere: estimate, exclude: [R07]}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(config->mode, ProcessMode::Rtk);
+  EXPECT_EQ(config->rtk.ar_mode, rtk::ArMode::FixAndHold);
+  EXPECT_EQ(config->rtk.observables.num_frequencies, 1);
+  EXPECT_TRUE(config->rtk.glonass_ar);
+  EXPECT_EQ(config->rtk.ionosphere, rtk::IonosphereModel::Estimate);
+  ASSERT_TRUE(config->base_position_E_m.has_value());
+  EXPECT_NEAR(config->base_position_E_m->x(), -3959400.631, 1e-6);
+  auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+  for (const char* bad : {"rtk: {ar_mode: sometimes}", "rtk: {frequencies: 4}", "base_position: [1, 2]",
+                          "rtk: {glonass_ar: maybe}", "rtk: {ionosphere: klobuchar}", "rtk: {ratio: 3}"}) {
+    EXPECT_FALSE(parse(bad).ok()) << bad;
+  }
 }
 
 TEST(ProcessConfigTest, PrintsAndParsesBackEqual) {

@@ -2,8 +2,9 @@
 // Kinematic RTK: an extended Kalman filter over the rover position and single-differenced carrier-phase
 // ambiguities, double-differenced code and phase measurements, and MLAMBDA integer ambiguity resolution.
 //
-// State x = [p_E_u (3) | v_E_u, a_E_u (6, with dynamics) | N_sd (one per (satellite, frequency), cycles)], where
-// N_sd = N_rover - N_base. Ambiguities are keyed by (satellite, frequency rank): added when both receivers track the
+// State x = [p_E_u (3) | v_E_u, a_E_u (6, with dynamics) | N_sd (one per (satellite, frequency), cycles)
+//            | I_sd (one per satellite, m, when the ionosphere is estimated)], where N_sd = N_rover - N_base.
+//            Ambiguities are keyed by (satellite, frequency rank): added when both receivers track the
 // pair, reset on a cycle slip or after an outage, removed when lost.
 //
 // Measurements, per group g = (constellation, frequency) with reference satellite r (highest elevation) and
@@ -47,31 +48,40 @@ struct SingleDiff;  // one (satellite, frequency) rover-base single difference (
 
 enum class ArMode { Off, Continuous, Instantaneous, FixAndHold };
 
+/// Differential ionosphere: neglected (short baselines) or estimated as one single-differenced slant delay per
+/// satellite (L1-band metres, scaled by (f_1 / f)^2 on other frequencies; it delays code and advances phase).
+enum class IonosphereModel { Off, Estimate };
+
 struct RtkOptions {
-  ObservableOptions observables;            ///< systems, number of frequencies (1..3), excluded satellites
+  ObservableOptions observables;  ///< systems, number of frequencies (1..3), excluded satellites
   ArMode ar_mode = ArMode::Continuous;
   double elevation_mask_rad = 15.0 * 0.017453292519943295;     ///< satellites below are not used
   double ar_elevation_mask_rad = 15.0 * 0.017453292519943295;  ///< ambiguities below are not fixed
-  bool dynamics = false;                    ///< constant-acceleration model; false: position from SPP each epoch
-  double accel_sigma_h_mps2 = 3.0;          ///< horizontal acceleration noise (m/s^2 per sqrt(s)) with dynamics
-  double accel_sigma_v_mps2 = 1.0;          ///< vertical acceleration noise with dynamics
-  double phase_sigma_m = 0.003;             ///< a: zenith-independent phase noise (m)
-  double phase_sigma_el_m = 0.003;          ///< b: elevation-dependent phase noise (m), divided by sin(el)
-  double code_phase_ratio = 100.0;          ///< code sigma / phase sigma
-  double initial_ambiguity_sigma_cyc = 30.0;     ///< sigma of a new ambiguity (cycles)
-  double ambiguity_noise_cyc = 1e-4;             ///< ambiguity random walk (cycles per sqrt(s))
-  double initial_position_sigma_m = 30.0;        ///< sigma of the SPP position used as prior (m)
-  double ratio_threshold = 3.0;             ///< ratio test threshold (the paper's 3.0)
-  int min_fix_ambiguities = 4;              ///< fewer DD ambiguities are not fixed
-  int min_lock_epochs = 0;                  ///< epochs an ambiguity must be tracked before it is fixed
-  bool glonass_ar = false;                  ///< fix GLONASS ambiguities (needs equal inter-frequency biases)
-  double max_age_s = 30.0;                  ///< base observations older than this are not used
-  double max_phase_innovation_m = 30.0;     ///< DD phase innovations beyond are rejected as outliers
-  double max_code_innovation_m = 100.0;     ///< DD code innovations beyond are rejected as outliers
-  double hold_sigma_cyc = 0.001;            ///< fix-and-hold pseudo-measurement sigma (cycles)
-  double max_outage_s = 5.0;                ///< an ambiguity not observed for longer is re-initialised
-  double slip_gf_threshold_m = 0.05;        ///< geometry-free phase jump counted as a cycle slip (m)
-  gnss::SppOptions spp;                     ///< single-point solution (prior and fallback)
+  bool dynamics = false;                      ///< constant-acceleration model; false: position from SPP each epoch
+  double accel_sigma_h_mps2 = 3.0;            ///< horizontal acceleration noise (m/s^2 per sqrt(s)) with dynamics
+  double accel_sigma_v_mps2 = 1.0;            ///< vertical acceleration noise with dynamics
+  double phase_sigma_m = 0.003;               ///< a: zenith-independent phase noise (m)
+  double phase_sigma_el_m = 0.003;            ///< b: elevation-dependent phase noise (m), divided by sin(el)
+  double code_phase_ratio = 100.0;            ///< code sigma / phase sigma
+  double initial_ambiguity_sigma_cyc = 30.0;  ///< sigma of a new ambiguity (cycles)
+  double ambiguity_noise_cyc = 1e-4;          ///< ambiguity random walk (cycles per sqrt(s))
+  double initial_position_sigma_m = 30.0;     ///< sigma of the SPP position used as prior (m)
+  double ratio_threshold = 3.0;               ///< ratio test threshold (the paper's 3.0)
+  int min_fix_ambiguities = 4;                ///< fewer DD ambiguities are not fixed
+  bool partial_ar = true;                     ///< when the full set fails, fix without one (system, frequency) group
+  int min_lock_epochs = 0;                    ///< epochs an ambiguity must be tracked before it is fixed
+  bool glonass_ar = false;                    ///< fix GLONASS ambiguities (needs equal inter-frequency biases)
+  double max_age_s = 30.0;                    ///< base observations older than this are not used
+  double max_phase_innovation_m = 30.0;       ///< DD phase innovations beyond are rejected as outliers
+  double max_code_innovation_m = 100.0;       ///< DD code innovations beyond are rejected as outliers
+  double hold_sigma_cyc = 0.001;              ///< fix-and-hold pseudo-measurement sigma (cycles)
+  double max_outage_s = 5.0;                  ///< an ambiguity not observed for longer is re-initialised
+  double slip_gf_threshold_m = 0.05;          ///< geometry-free phase jump counted as a cycle slip (m)
+  bool troposphere_saastamoinen = true;       ///< model the troposphere at each receiver (off: data without one)
+  IonosphereModel ionosphere = IonosphereModel::Off;  ///< differential ionosphere model
+  double iono_sigma_per_10km_m = 0.03;  ///< prior sigma of a SD ionosphere state per 10 km of baseline (m)
+  double iono_noise_m = 0.001;          ///< SD ionosphere random walk (m per sqrt(s))
+  gnss::SppOptions spp;                 ///< single-point solution (prior and fallback)
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;
@@ -79,11 +89,11 @@ struct RtkOptions {
 
 /// One epoch's result.
 struct RtkEpoch {
-  core::Solution solution;        ///< status Fixed, Float or Single
-  int num_fixed_ambiguities = 0;  ///< DD ambiguities in the accepted fix (0 if not fixed)
-  int num_dd_measurements = 0;    ///< DD phase measurements used in the update
+  core::Solution solution;                  ///< status Fixed, Float or Single
+  int num_fixed_ambiguities = 0;            ///< DD ambiguities in the accepted fix (0 if not fixed)
+  int num_dd_measurements = 0;              ///< DD phase measurements used in the update
   std::vector<core::SatelliteId> rejected;  ///< satellites whose measurements failed the innovation gate
-  std::string note;               ///< why the epoch is not fixed, if it is not (for --verbose)
+  std::string note;                         ///< why the epoch is not fixed, if it is not (for --verbose)
 };
 
 /// The RTK filter. Feed rover epochs in time order with the base epoch to use (nullptr if none).
@@ -95,7 +105,10 @@ class RtkEngine {
   Result<RtkEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base);
 
  private:
-  using AmbiguityKey = std::pair<core::SatelliteId, int>;  // (satellite, frequency rank)
+  // Keyed states after the kinematic block: (satellite, frequency rank) for an ambiguity, (satellite, kIonoKey) for
+  // the satellite's SD ionosphere.
+  using AmbiguityKey = std::pair<core::SatelliteId, int>;
+  static constexpr int kIonoKey = -1;
   struct AmbiguityInfo {
     int lock_epochs = 0;
     core::GpsTime last_seen;
@@ -108,9 +121,21 @@ class RtkEngine {
   void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
   /// EKF update with the DD code and phase; returns the number of DD phase rows used.
   int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
-  /// MLAMBDA and the ratio test; fills the fixed solution of `out` and returns true when fixed.
+  /// A candidate fix of a set of DD ambiguities (state index of s, of its reference).
+  struct Fix {
+    Eigen::MatrixXd D;  // DD ambiguities = D x
+    Eigen::VectorXd a_float;
+    Eigen::MatrixXd Q_a;    // D P D^T
+    Eigen::MatrixXd PDt;    // P D^T
+    Eigen::VectorXd a_fix;  // best integer candidate
+    double ratio = 0.0;
+    double squared_norm = 0.0;  // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
+  };
+  [[nodiscard]] std::optional<Fix> try_fix(const std::vector<std::pair<int, int>>& dd) const;
+  /// MLAMBDA and the ratio test, then partial fixing without one group if the whole set fails; fills the fixed
+  /// solution of `out` and returns true when fixed.
   bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
-  void add_ambiguity(const AmbiguityKey& key, double value_cyc);
+  void add_ambiguity(const AmbiguityKey& key, double value, double variance);
   void remove_ambiguity(const AmbiguityKey& key);
   [[nodiscard]] int ambiguity_index(const AmbiguityKey& key) const;
   [[nodiscard]] int num_kinematic_states() const { return options_.dynamics ? 9 : 3; }
