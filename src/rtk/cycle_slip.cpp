@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/observation.hpp"
