@@ -3,6 +3,7 @@
 #include "canyon/rtk/engine.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -66,13 +67,34 @@ double zero_diff_phase_variance(const RtkOptions& o, double elevation_rad) {
   return o.phase_sigma_m * o.phase_sigma_m + o.phase_sigma_el_m * o.phase_sigma_el_m / (sin_el * sin_el);
 }
 
-/// A linear(ised) DD measurement row: h = H x, innovation v, and which SDs it differences.
+/// A linear(ised) DD measurement row, sparse: h = h_pos . p + sum of entries (state index, coefficient); innovation v,
+/// and which SDs it differences. At most 4 non-position entries: two ambiguities and two ionosphere states.
 struct DdRow {
-  Eigen::RowVectorXd H;
+  Eigen::Vector3d h_pos = Eigen::Vector3d::Zero();
+  std::array<std::pair<int, double>, 4> entries{};
+  int num_entries = 0;
   double innovation_m = 0.0;
   int sd = -1;         // index into the SD list of satellite s
   int reference = -1;  // index of the reference satellite's SD
   bool phase = true;
+
+  void add(int index, double coefficient) {
+    for (int k = 0; k < num_entries; ++k) {
+      if (entries[static_cast<std::size_t>(k)].first == index) {
+        entries[static_cast<std::size_t>(k)].second += coefficient;
+        return;
+      }
+    }
+    entries[static_cast<std::size_t>(num_entries++)] = {index, coefficient};
+  }
+  /// This row times the columns of M (M has the state dimension as rows): (H M) for one row.
+  [[nodiscard]] Eigen::RowVectorXd times(const Eigen::MatrixXd& M) const {
+    Eigen::RowVectorXd r = h_pos.transpose() * M.topRows<3>();
+    for (int k = 0; k < num_entries; ++k) {
+      r += entries[static_cast<std::size_t>(k)].second * M.row(entries[static_cast<std::size_t>(k)].first);
+    }
+    return r;
+  }
 };
 
 }  // namespace
@@ -299,13 +321,12 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
         row.phase = phase;
         row.sd = i;
         row.reference = reference;
-        row.H = Eigen::RowVectorXd::Zero(n);
-        row.H.head<3>() = -(sd.los_E - ref.los_E).transpose();
+        row.h_pos = -(sd.los_E - ref.los_E);
         double predicted_m = 0.0;
         double observed_m = 0.0;
         if (phase) {
-          row.H[sd.ambiguity] = sd.wavelength_m;
-          row.H[ref.ambiguity] = -ref.wavelength_m;
+          row.add(sd.ambiguity, sd.wavelength_m);
+          row.add(ref.ambiguity, -ref.wavelength_m);
           predicted_m = sd.wavelength_m * x_[sd.ambiguity] - ref.wavelength_m * x_[ref.ambiguity];
           observed_m = sd.phase_m - ref.phase_m;
         } else {
@@ -314,8 +335,8 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
         if (sd.iono >= 0 && ref.iono >= 0) {
           // The ionosphere advances phase and delays code by iono_scale * I_sd.
           const double sign = phase ? -1.0 : 1.0;
-          row.H[sd.iono] += sign * sd.iono_scale;
-          row.H[ref.iono] -= sign * ref.iono_scale;
+          row.add(sd.iono, sign * sd.iono_scale);
+          row.add(ref.iono, -sign * ref.iono_scale);
           predicted_m += sign * (sd.iono_scale * x_[sd.iono] - ref.iono_scale * x_[ref.iono]);
         }
         // The SD residuals were formed at the prior position: the geometry term is already in observed_m, and
@@ -332,12 +353,13 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
   }
   if (rows.empty()) return 0;
   const auto m = static_cast<Eigen::Index>(rows.size());
-  Eigen::MatrixXd H(m, n);
   Eigen::VectorXd v(m);
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, m);
+  // P H^T column by column from the sparse rows (P is symmetric: column a of P H^T is row a of H P, transposed).
+  Eigen::MatrixXd PHt(n, m);
   for (Eigen::Index a = 0; a < m; ++a) {
     const DdRow& ra = rows[static_cast<std::size_t>(a)];
-    H.row(a) = ra.H;
+    PHt.col(a) = ra.times(P_).transpose();
     v[a] = ra.innovation_m;
     const auto variance = [&](int i) {
       const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
@@ -349,13 +371,16 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
       if (rb.phase == ra.phase && rb.reference == ra.reference) R(a, b) = R(b, a) = variance(ra.reference);
     }
   }
-  // Kalman update: K = P H^T (H P H^T + R)^-1.
-  const Eigen::MatrixXd PHt = P_ * H.transpose();
-  const Eigen::MatrixXd S = H * PHt + R;
+  // S = H P H^T + R, row by row from the sparse rows: S_a = H_a (P H^T).
+  Eigen::MatrixXd S = R;
+  for (Eigen::Index a = 0; a < m; ++a) S.row(a) += rows[static_cast<std::size_t>(a)].times(PHt);
+  S = 0.5 * (S + S.transpose()).eval();
+  // Kalman update: K = P H^T S^-1.
   const Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success) return 0;
   x_ += PHt * llt.solve(v);
-  P_ -= PHt * llt.solve(PHt.transpose());
+  const Eigen::MatrixXd L_inv_HP = llt.matrixL().solve(PHt.transpose());  // L^-1 H P, m x n
+  P_.noalias() -= L_inv_HP.transpose() * L_inv_HP;
   P_ = 0.5 * (P_ + P_.transpose()).eval();
   int phase_rows = 0;
   for (const DdRow& r : rows) phase_rows += r.phase ? 1 : 0;
@@ -392,14 +417,19 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
   const auto nd = static_cast<Eigen::Index>(dd.size());
   if (nd < options_.min_fix_ambiguities) return std::nullopt;
   Fix fix;
-  fix.D = Eigen::MatrixXd::Zero(nd, x_.size());
+  // D has +1 and -1 per row: D x, P D^T and D P D^T from columns of P, without dense products.
+  fix.a_float.resize(nd);
+  fix.PDt.resize(x_.size(), nd);
   for (Eigen::Index k = 0; k < nd; ++k) {
-    fix.D(k, dd[static_cast<std::size_t>(k)].first) = 1.0;
-    fix.D(k, dd[static_cast<std::size_t>(k)].second) = -1.0;
+    const auto [s, r] = dd[static_cast<std::size_t>(k)];
+    fix.a_float[k] = x_[s] - x_[r];
+    fix.PDt.col(k) = P_.col(s) - P_.col(r);
   }
-  fix.a_float = fix.D * x_;
-  fix.PDt = P_ * fix.D.transpose();
-  fix.Q_a = fix.D * fix.PDt;
+  fix.Q_a.resize(nd, nd);
+  for (Eigen::Index k = 0; k < nd; ++k) {
+    const auto [s, r] = dd[static_cast<std::size_t>(k)];
+    fix.Q_a.row(k) = fix.PDt.row(s) - fix.PDt.row(r);
+  }
   fix.Q_a = 0.5 * (fix.Q_a + fix.Q_a.transpose()).eval();
   auto search = mlambda(fix.a_float, fix.Q_a);
   if (!search) return std::nullopt;

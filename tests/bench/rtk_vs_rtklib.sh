@@ -17,10 +17,9 @@
 #     systems: [G, E]                                         <- pos1-navsys (1 G, 4 R, 8 E, 16 J, 32 C)
 #     ratio_threshold: 3.0                                    <- pos2-arthres
 #     glonass_ar: off | on                                    <- pos2-gloarmode
-# THESE KEYS MUST MATCH config/rtk.yaml once the RTK engine ships it (they were chosen before it existed); the
-# RTKLIB files' other settings (Klobuchar/Saastamoinen or no atmosphere models, process noises) have no key yet.
-# Until `canyon process --mode rtk` is accepted, the script says "canyon rtk mode not available yet", still prints
-# RTKLIB's side, and exits 0.
+#     troposphere: saastamoinen | off                         <- pos1-tropopt (with spp models off likewise)
+# (keys as in config/rtk.yaml; the other options keep their defaults there). If canyon rejects `--mode rtk`, the
+# script says so, still prints RTKLIB's side, and exits 0.
 #
 # Usage: tests/bench/rtk_vs_rtklib.sh [BUILD_DIR] [RUNS]     (defaults: build, 5 timed runs of each program)
 # Environment: CANYON_SHARED_DATA_DIR (default ../shared/data), KEEP=1 keeps the temp folder and prints its path.
@@ -139,6 +138,12 @@ write_yaml() {
   ((navsys & 16)) && systems+="J, "
   gloar=$(conf_value "$conf" pos2-gloarmode)
   [[ $gloar == off ]] || gloar=on
+  local tropo=saastamoinen spp_models=""
+  if [[ $(conf_value "$conf" pos1-tropopt) == off ]]; then
+    tropo=off
+    spp_models=$'spp:\n  troposphere: off\n'
+  fi
+  [[ $(conf_value "$conf" pos1-ionoopt) == off ]] && spp_models=${spp_models:-$'spp:\n'}$'  ionosphere: off\n'
   cat <<YAML
 # canyon equivalent of $(basename "$conf") (written by tests/bench/rtk_vs_rtklib.sh)
 mode: rtk
@@ -149,7 +154,9 @@ rtk:
   systems: [${systems%, }]
   ratio_threshold: $(conf_value "$conf" pos2-arthres)
   glonass_ar: $gloar
+  troposphere: $tropo
 YAML
+  printf '%s' "$spp_models"
 }
 
 # Milliseconds one run takes: bash's `time` over the command, median of $runs.
