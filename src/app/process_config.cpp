@@ -62,6 +62,7 @@ void parse_systems(YamlMap& map, std::vector<std::string> systems, bool& gps, bo
 
 void parse_satellites(YamlMap& map, const std::string& key, std::vector<core::SatelliteId>& out) {
   std::vector<std::string> texts;
+  texts.reserve(out.size());
   for (const auto& sat : out) texts.push_back(sat.to_string());
   map.get(key, texts);
   out.clear();

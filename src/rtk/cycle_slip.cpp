@@ -72,7 +72,7 @@ std::string CycleSlipOptions::validate() const {
   return {};
 }
 
-CycleSlipDetector::CycleSlipDetector(CycleSlipOptions options) : options_(std::move(options)) {
+CycleSlipDetector::CycleSlipDetector(CycleSlipOptions options) : options_(options) {
   assert(options_.validate().empty() && "invalid CycleSlipOptions");
 }
 
@@ -182,6 +182,7 @@ void CycleSlipDetector::test_doppler(std::vector<Current>& signals, core::GpsTim
     residuals.push_back(Residual{&c, residual_m, scale, dt_s});
   }
   std::vector<core::SatelliteId> satellites;
+  satellites.reserve(residuals.size());
   for (const Residual& r : residuals) satellites.push_back(r.signal->key.first);
   satellites.erase(std::unique(satellites.begin(), satellites.end()), satellites.end());  // sorted already
   if (static_cast<int>(satellites.size()) < options_.doppler_min_satellites) return;
