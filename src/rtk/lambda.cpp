@@ -61,6 +61,28 @@ double gauss_multiplier(double x) {
   return std::abs(x) <= 0.5 ? 0.0 : std::round(x);
 }
 
+/// One factor of Z = P O_1 O_2 ...: an integer Gauss transformation I - mu e_i e_k^T, or (mu == 0) the swap of
+/// k and k + 1 (then i == k + 1).
+struct ElementaryOperation {
+  Eigen::Index i;
+  Eigen::Index k;
+  double mu;
+};
+
+/// a = Z^{-T} z = P O_1^{-T} O_2^{-T} ... z, exact in integer arithmetic; O(number of operations), not O(n^2) per
+/// operation as accumulating Z^{-1} would be. (I - mu e_i e_k^T)^{-T} = I + mu e_k e_i^T.
+void back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm, double* z,
+                    double* a) {
+  for (auto op = log.rbegin(); op != log.rend(); ++op) {
+    if (op->mu == 0.0) {
+      std::swap(z[op->k], z[op->i]);
+    } else {
+      z[op->k] += op->mu * z[op->i];
+    }
+  }
+  for (std::size_t i = 0; i < perm.size(); ++i) a[perm[i]] = z[i];
+}
+
 /// Working view of a decorrelation during factorisation and reduction: raw column-major n x n arrays, so that every
 /// update below is a plain loop without Eigen temporaries. Z_inv is kept transposed (Z_inv_T = Z^{-T}) so that its
 /// updates are column operations too, and the back-transform a = Z^{-T} z is a product with Z_inv_T.
@@ -69,8 +91,10 @@ struct ReductionView {
   double* L;        // L(i, k) = L[i + k n], unit lower triangular
   double* d;        // d[k]
   double* Z;        // Z(i, k) = Z[i + k n]
-  double* Z_inv_T;  // Z^{-T}(i, k) = Z_inv_T[i + k n]
+  double* Z_inv_T;  // Z^{-T}(i, k) = Z_inv_T[i + k n], or nullptr when the operations are logged instead
   double* z_hat;    // Z^T (a_float - shift), or nullptr
+  std::vector<Eigen::Index>* perm = nullptr;        // initial permutation: Z(perm[i], i) = 1 before the reduction
+  std::vector<ElementaryOperation>* log = nullptr;  // Z = P O_1 O_2 ..., in order, when Z_inv_T is nullptr
 };
 
 /// Q = P L^T D L P^T with symmetric pivoting (see the contract): fills L, d, and Z = P, Z_inv_T = P.
@@ -103,16 +127,18 @@ Status factorise_with_pivoting(const Eigen::MatrixXd& Q, Eigen::MatrixXd& W, con
     v.d[k] = d_k;
     v.L[k + k * n] = 1.0;
     for (Eigen::Index j = 0; j < k; ++j) v.L[k + j * n] = w[k + j * n] / d_k;
-    // W(0:k-1, 0:k-1) -= d_k l l^T with l = L(k, 0:k-1), i.e. W(i, j) -= W(k, i) L(k, j).
+    // W(0:k-1, 0:k-1) -= d_k l l^T with l = L(k, 0:k-1), i.e. W(i, j) -= W(i, k) L(k, j) (W stays symmetric, so
+    // column k is row k and the update reads contiguous memory).
+    const double* w_col_k = w + k * n;
     for (Eigen::Index j = 0; j < k; ++j) {
       const double l_j = v.L[k + j * n];
       double* w_col = w + j * n;
-      const double* w_row_k = w + k;  // w_row_k[i * n] = W(k, i) = W(i, k)
-      for (Eigen::Index i = 0; i < k; ++i) w_col[i] -= w_row_k[i * n] * l_j;
+      for (Eigen::Index i = 0; i < k; ++i) w_col[i] -= w_col_k[i] * l_j;
     }
   }
   for (Eigen::Index i = 0; i < n; ++i) v.Z[perm[static_cast<std::size_t>(i)] + i * n] = 1.0;
-  std::copy(v.Z, v.Z + n * n, v.Z_inv_T);  // a permutation: Z^{-T} = Z
+  if (v.Z_inv_T != nullptr) std::copy(v.Z, v.Z + n * n, v.Z_inv_T);  // a permutation: Z^{-T} = Z
+  if (v.perm != nullptr) *v.perm = std::move(perm);
   return Ok{};
 }
 
@@ -127,9 +153,13 @@ bool gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
   double* Z_k = v.Z + k * n;
   const double* Z_i = v.Z + i * n;
   for (Eigen::Index r = 0; r < n; ++r) Z_k[r] -= mu * Z_i[r];
-  double* Zit_i = v.Z_inv_T + i * n;  // Z^{-1} <- G^{-1} Z^{-1}: row i += mu row k, i.e. column i of Z^{-T}
-  const double* Zit_k = v.Z_inv_T + k * n;
-  for (Eigen::Index r = 0; r < n; ++r) Zit_i[r] += mu * Zit_k[r];
+  if (v.Z_inv_T != nullptr) {
+    double* Zit_i = v.Z_inv_T + i * n;  // Z^{-1} <- G^{-1} Z^{-1}: row i += mu row k, i.e. column i of Z^{-T}
+    const double* Zit_k = v.Z_inv_T + k * n;
+    for (Eigen::Index r = 0; r < n; ++r) Zit_i[r] += mu * Zit_k[r];
+  } else {
+    v.log->push_back({i, k, mu});
+  }
   if (v.z_hat != nullptr) v.z_hat[k] -= mu * v.z_hat[i];
   return true;
 }
@@ -154,50 +184,62 @@ void swap_neighbours(const ReductionView& v, Eigen::Index k, double delta) {
   v.d[k] = eta * d_k1;
   v.d[k + 1] = delta;
   std::swap_ranges(v.Z + k * n, v.Z + (k + 1) * n, v.Z + (k + 1) * n);
-  std::swap_ranges(v.Z_inv_T + k * n, v.Z_inv_T + (k + 1) * n, v.Z_inv_T + (k + 1) * n);
+  if (v.Z_inv_T != nullptr) {
+    std::swap_ranges(v.Z_inv_T + k * n, v.Z_inv_T + (k + 1) * n, v.Z_inv_T + (k + 1) * n);
+  } else {
+    v.log->push_back({k + 1, k, 0.0});
+  }
   if (v.z_hat != nullptr) std::swap(v.z_hat[k], v.z_hat[k + 1]);
 }
 
-/// MLAMBDA reduction (decorrelation) of an already factorised problem.
+/// Reduction (decorrelation) of an already factorised problem: the swaps of MLAMBDA's reduction, with only the
+/// sub-diagonal entry size-reduced before each swap test and one size-reduction pass at the end (see the contract).
 Status reduce(const ReductionView& v) {
   const Eigen::Index n = v.n;
   Eigen::Index k = n - 2;
-  Eigen::Index last_swap = n - 2;  // columns > last_swap are still size-reduced (lazy transformations)
   std::int64_t steps = 0;
   while (k >= 0) {
     if (++steps > kMaxReductionSteps) {
       return Error("mlambda: reduction did not terminate within " + std::to_string(kMaxReductionSteps) + " steps");
     }
-    if (k <= last_swap) {
-      for (Eigen::Index i = k + 1; i < n; ++i) gauss_transform(v, i, k);
-    }
+    gauss_transform(v, k + 1, k);
     const double mu = v.L[(k + 1) + k * n];
     const double delta = v.d[k] + mu * mu * v.d[k + 1];
     if (delta < (1.0 - kSwapTolerance) * v.d[k + 1]) {
+      // The swap moves column k below row k + 1 into column k + 1: size-reduce it first so that unreduced entries
+      // cannot grow over repeated swaps (the instability of reducing the sub-diagonal only). Leaves L_{k+1,k}, d.
+      for (Eigen::Index i = k + 2; i < n; ++i) gauss_transform(v, i, k);
       swap_neighbours(v, k, delta);
-      last_swap = k;
       k = n - 2;
     } else {
       --k;
     }
   }
+  // Size reduction: |L_ik| <= 1/2 for all i > k. Column k is reduced from the top (i = k + 1 first): G_ik changes
+  // only rows >= i of column k, which are reduced afterwards; d and the columns > k are untouched.
+  for (Eigen::Index col = n - 2; col >= 0; --col) {
+    for (Eigen::Index i = col + 1; i < n; ++i) gauss_transform(v, i, col);
+  }
   return Ok{};
 }
 
-/// Factorisation and reduction into dec (Z_inv left transposed in dec.Z_inv: the caller decides).
-Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, Eigen::VectorXd* z_hat_from,
-                        const Eigen::VectorXd* a_centred) {
+/// Factorisation and reduction into dec. With log == nullptr, dec.Z_inv receives Z^{-T}; otherwise dec.Z_inv is
+/// left empty and the operations are logged (with the initial permutation) for back_transform().
+Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, Eigen::VectorXd* z_hat,
+                        const Eigen::VectorXd* a_centred, std::vector<Eigen::Index>* perm,
+                        std::vector<ElementaryOperation>* log) {
   const Eigen::Index n = Q_a.rows();
   dec.L.resize(n, n);
   dec.d.resize(n);
   dec.Z.resize(n, n);
-  dec.Z_inv.resize(n, n);
-  ReductionView v{n, dec.L.data(), dec.d.data(), dec.Z.data(), dec.Z_inv.data(), nullptr};
+  if (log == nullptr) dec.Z_inv.resize(n, n);
+  ReductionView v{n,       dec.L.data(), dec.d.data(), dec.Z.data(), log == nullptr ? dec.Z_inv.data() : nullptr,
+                  nullptr, perm,         log};
   Eigen::MatrixXd W;
   if (auto s = factorise_with_pivoting(Q_a, W, v); !s) return s;
-  if (z_hat_from != nullptr) {
-    *z_hat_from = dec.Z.transpose() * *a_centred;
-    v.z_hat = z_hat_from->data();
+  if (z_hat != nullptr) {
+    *z_hat = dec.Z.transpose() * *a_centred;
+    v.z_hat = z_hat->data();
   }
   return reduce(v);
 }
@@ -332,7 +374,7 @@ Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a) {
   if (!Q_a.allFinite()) return Error("decorrelate: Q_a has a non-finite entry");
   if (auto s = check_symmetric(Q_a, "decorrelate"); !s) return s.error();
   Decorrelation dec;
-  if (auto s = decorrelate_into(Q_a, dec, nullptr, nullptr); !s) return s.error();
+  if (auto s = decorrelate_into(Q_a, dec, nullptr, nullptr, nullptr, nullptr); !s) return s.error();
   dec.Z_inv.transposeInPlace();
   return dec;
 }
@@ -343,11 +385,14 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
   if (auto s = check_problem(a_float, Q_a, "mlambda"); !s) return s.error();
   if (auto s = check_symmetric(Q_a, "mlambda"); !s) return s.error();
 
-  Decorrelation dec;  // dec.Z_inv holds Z^{-T} here
+  Decorrelation dec;  // dec.Z_inv stays empty: the candidates are back-transformed through the operation log
   const Eigen::VectorXd shift = a_float.array().round().matrix();
   const Eigen::VectorXd a_centred = a_float - shift;
   Eigen::VectorXd z_hat;
-  if (auto s = decorrelate_into(Q_a, dec, &z_hat, &a_centred); !s) return s.error();
+  std::vector<Eigen::Index> perm;
+  std::vector<ElementaryOperation> log;
+  log.reserve(1024);
+  if (auto s = decorrelate_into(Q_a, dec, &z_hat, &a_centred, &perm, &log); !s) return s.error();
 
   IntegerSearchResult out;
   auto found = search(dec, z_hat, options.num_candidates, options.max_search_nodes, out.search_nodes);
@@ -362,8 +407,7 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
   out.squared_norms.resize(m);
   for (int j = 0; j < m; ++j) {
     const int from = order[static_cast<std::size_t>(j)];
-    // Exact: integer matrix times integer vector.
-    out.candidates.col(j).noalias() = dec.Z_inv * found->z.col(from);
+    back_transform(log, perm, found->z.col(from).data(), out.candidates.col(j).data());  // exact: integers
     out.candidates.col(j) += shift;
     out.squared_norms(j) = found->squared_norms(from);
   }
