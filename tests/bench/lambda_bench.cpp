@@ -14,8 +14,14 @@
 // Reproduce (Release, idle machine, 2 cores, Debian 12, g++ 12):
 //   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && make -C build -j2 bench_lambda
 //   build/tests/bench/bench_lambda          (rows ending in _median; --benchmark_filter=BM_Mlambda/n:30 for one size)
-// Results before the optimisation of the decorrelation (median of 15 repetitions, CPU us):
-//   realistic n = 30: k = 1: 82, k = 5: 79, k = 20: 42; single-epoch worst case n = 30: 993 (41k search nodes).
+// Results (median of 15 repetitions, us; shared 2-core machine, run-to-run cv 2-18 %, so treat +-20 % as noise):
+//                          n = 10   n = 20   n = 30
+//   realistic k = 1          7.2     38.6     35.3   (previous run: 51)
+//   realistic k = 5          4.6     24.1     44.2   (previous run: 51)
+//   realistic k = 20         4.2     13.7     34.1   (previous run: 29)
+//   single-epoch worst       8.1     73.4      863   (41k search nodes at n = 30: the search dominates)
+// Before the rewrite of the reduction (commit 888f135): realistic n = 30 k = 1 / 5 / 20: 82 / 79 / 42, single-epoch
+// n = 30: 993.
 
 #include <algorithm>
 #include <chrono>
