@@ -55,165 +55,275 @@ Status check_symmetric(const Eigen::MatrixXd& Q, const char* who) {
   return Ok{};
 }
 
-/// Q = P^T ... : factorises the symmetrised Q with symmetric pivoting, filling L, d, and Z = P, Z_inv = P^T.
-Status factorise_with_pivoting(const Eigen::MatrixXd& Q, Decorrelation& out) {
-  const Eigen::Index n = Q.rows();
-  Eigen::MatrixXd W = 0.5 * (Q + Q.transpose());
+/// Round to nearest for a multiplier of an integer Gauss transformation; 0 when |x| <= 1/2 (already size-reduced),
+/// which is the common case and avoids the libm call.
+double gauss_multiplier(double x) {
+  return std::abs(x) <= 0.5 ? 0.0 : std::round(x);
+}
+
+/// One factor of Z = P O_1 O_2 ...: an integer Gauss transformation I - mu e_i e_k^T, or (mu == 0) the swap of
+/// k and k + 1 (then i == k + 1).
+struct ElementaryOperation {
+  Eigen::Index i;
+  Eigen::Index k;
+  double mu;
+};
+
+/// a = Z^{-T} z = P O_1^{-T} O_2^{-T} ... z, exact in integer arithmetic; O(number of operations), not O(n^2) per
+/// operation as accumulating Z^{-1} would be. (I - mu e_i e_k^T)^{-T} = I + mu e_k e_i^T.
+void back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm, double* z,
+                    double* a) {
+  for (auto op = log.rbegin(); op != log.rend(); ++op) {
+    if (op->mu == 0.0) {
+      std::swap(z[op->k], z[op->i]);
+    } else {
+      z[op->k] += op->mu * z[op->i];
+    }
+  }
+  for (std::size_t i = 0; i < perm.size(); ++i) a[perm[i]] = z[i];
+}
+
+/// Working view of a decorrelation during factorisation and reduction: raw column-major n x n arrays, so that every
+/// update below is a plain loop without Eigen temporaries. Z_inv is kept transposed (Z_inv_T = Z^{-T}) so that its
+/// updates are column operations too, and the back-transform a = Z^{-T} z is a product with Z_inv_T.
+struct ReductionView {
+  Eigen::Index n;
+  double* L;        // L(i, k) = L[i + k n], unit lower triangular
+  double* d;        // d[k]
+  double* Z;        // Z(i, k) = Z[i + k n]
+  double* Z_inv_T;  // Z^{-T}(i, k) = Z_inv_T[i + k n], or nullptr when the operations are logged instead
+  double* z_hat;    // Z^T (a_float - shift), or nullptr
+  std::vector<Eigen::Index>* perm = nullptr;        // initial permutation: Z(perm[i], i) = 1 before the reduction
+  std::vector<ElementaryOperation>* log = nullptr;  // Z = P O_1 O_2 ..., in order, when Z_inv_T is nullptr
+};
+
+/// Q = P L^T D L P^T with symmetric pivoting (see the contract): fills L, d, and Z = P, Z_inv_T = P.
+Status factorise_with_pivoting(const Eigen::MatrixXd& Q, Eigen::MatrixXd& W, const ReductionView& v) {
+  const Eigen::Index n = v.n;
+  W = 0.5 * (Q + Q.transpose());
+  double* w = W.data();
   const double min_pivot = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * W.diagonal().maxCoeff();
+  std::fill(v.L, v.L + n * n, 0.0);
+  std::fill(v.Z, v.Z + n * n, 0.0);
+  // perm[i] = original index of the variable now at position i.
   std::vector<Eigen::Index> perm(static_cast<std::size_t>(n));
   std::iota(perm.begin(), perm.end(), Eigen::Index{0});
-  out.L = Eigen::MatrixXd::Identity(n, n);
-  out.d = Eigen::VectorXd::Zero(n);
   for (Eigen::Index k = n - 1; k >= 0; --k) {
-    Eigen::Index q = 0;
-    W.diagonal().head(k + 1).minCoeff(&q);
+    Eigen::Index q = k;
+    for (Eigen::Index i = 0; i < k; ++i) {
+      if (w[i + i * n] < w[q + q * n]) q = i;
+    }
     if (q != k) {
-      W.row(q).swap(W.row(k));
-      W.col(q).swap(W.col(k));
-      for (Eigen::Index r = k + 1; r < n; ++r) std::swap(out.L(r, q), out.L(r, k));
+      // Symmetric swap of q and k in the leading (k+1) x (k+1) block; rows > k of L move with the variables.
+      for (Eigen::Index i = 0; i <= k; ++i) std::swap(w[i + q * n], w[i + k * n]);
+      for (Eigen::Index j = 0; j <= k; ++j) std::swap(w[q + j * n], w[k + j * n]);
+      for (Eigen::Index r = k + 1; r < n; ++r) std::swap(v.L[r + q * n], v.L[r + k * n]);
       std::swap(perm[static_cast<std::size_t>(q)], perm[static_cast<std::size_t>(k)]);
     }
-    const double d_k = W(k, k);
+    const double d_k = w[k + k * n];
     if (!(d_k > min_pivot)) {
       return Error("mlambda: Q_a is not positive definite (pivot " + std::to_string(d_k) + ")");
     }
-    out.d(k) = d_k;
-    out.L.row(k).head(k) = W.row(k).head(k) / d_k;
-    W.topLeftCorner(k, k) -= d_k * out.L.row(k).head(k).transpose() * out.L.row(k).head(k);
+    v.d[k] = d_k;
+    v.L[k + k * n] = 1.0;
+    for (Eigen::Index j = 0; j < k; ++j) v.L[k + j * n] = w[k + j * n] / d_k;
+    // W(0:k-1, 0:k-1) -= d_k l l^T with l = L(k, 0:k-1), i.e. W(i, j) -= W(i, k) L(k, j) (W stays symmetric, so
+    // column k is row k and the update reads contiguous memory).
+    const double* w_col_k = w + k * n;
+    for (Eigen::Index j = 0; j < k; ++j) {
+      const double l_j = v.L[k + j * n];
+      double* w_col = w + j * n;
+      for (Eigen::Index i = 0; i < k; ++i) w_col[i] -= w_col_k[i] * l_j;
+    }
   }
-  out.Z = Eigen::MatrixXd::Zero(n, n);
-  for (Eigen::Index i = 0; i < n; ++i) out.Z(perm[static_cast<std::size_t>(i)], i) = 1.0;
-  out.Z_inv = out.Z.transpose();
+  for (Eigen::Index i = 0; i < n; ++i) v.Z[perm[static_cast<std::size_t>(i)] + i * n] = 1.0;
+  if (v.Z_inv_T != nullptr) std::copy(v.Z, v.Z + n * n, v.Z_inv_T);  // a permutation: Z^{-T} = Z
+  if (v.perm != nullptr) *v.perm = std::move(perm);
   return Ok{};
 }
 
-/// Integer Gauss transformation G_ik (i > k) applied to L, Z, Z_inv and (optionally) z_hat.
-void gauss_transform(Decorrelation& dec, Eigen::Index i, Eigen::Index k, Eigen::VectorXd* z_hat) {
-  const double mu = std::round(dec.L(i, k));
-  if (mu == 0.0) return;
-  const Eigen::Index n = dec.L.rows();
-  dec.L.col(k).tail(n - i) -= mu * dec.L.col(i).tail(n - i);
-  dec.Z.col(k) -= mu * dec.Z.col(i);
-  dec.Z_inv.row(i) += mu * dec.Z_inv.row(k);
-  if (z_hat != nullptr) (*z_hat)(k) -= mu * (*z_hat)(i);
+/// Integer Gauss transformation G_ik (i > k) applied to L, Z, Z_inv_T and z_hat; false when L_ik is already reduced.
+bool gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
+  const Eigen::Index n = v.n;
+  const double mu = gauss_multiplier(v.L[i + k * n]);
+  if (mu == 0.0) return false;
+  double* L_k = v.L + k * n;
+  const double* L_i = v.L + i * n;
+  for (Eigen::Index r = i; r < n; ++r) L_k[r] -= mu * L_i[r];
+  double* Z_k = v.Z + k * n;
+  const double* Z_i = v.Z + i * n;
+  for (Eigen::Index r = 0; r < n; ++r) Z_k[r] -= mu * Z_i[r];
+  if (v.Z_inv_T != nullptr) {
+    double* Zit_i = v.Z_inv_T + i * n;  // Z^{-1} <- G^{-1} Z^{-1}: row i += mu row k, i.e. column i of Z^{-T}
+    const double* Zit_k = v.Z_inv_T + k * n;
+    for (Eigen::Index r = 0; r < n; ++r) Zit_i[r] += mu * Zit_k[r];
+  } else {
+    v.log->push_back({i, k, mu});
+  }
+  if (v.z_hat != nullptr) v.z_hat[k] -= mu * v.z_hat[i];
+  return true;
 }
 
-/// Swap of neighbours k, k+1 given Delta = d_k + L_{k+1,k}^2 d_{k+1}.
-void swap_neighbours(Decorrelation& dec, Eigen::Index k, double delta, Eigen::VectorXd* z_hat) {
-  const Eigen::Index n = dec.L.rows();
-  const double mu = dec.L(k + 1, k);
-  const double d_k = dec.d(k);
-  const double d_k1 = dec.d(k + 1);
-  const Eigen::RowVectorXd row_k = dec.L.row(k).head(k);
-  const Eigen::RowVectorXd row_k1 = dec.L.row(k + 1).head(k);
-  dec.L.row(k).head(k) = row_k1 - mu * row_k;
-  dec.L.row(k + 1).head(k) = (d_k * row_k + d_k1 * mu * row_k1) / delta;
-  dec.L(k + 1, k) = d_k1 * mu / delta;
-  for (Eigen::Index r = k + 2; r < n; ++r) std::swap(dec.L(r, k), dec.L(r, k + 1));
-  dec.d(k) = d_k * d_k1 / delta;
-  dec.d(k + 1) = delta;
-  dec.Z.col(k).swap(dec.Z.col(k + 1));
-  dec.Z_inv.row(k).swap(dec.Z_inv.row(k + 1));
-  if (z_hat != nullptr) std::swap((*z_hat)(k), (*z_hat)(k + 1));
+/// Swap of neighbours k, k+1 given Delta = d_k + L_{k+1,k}^2 d_{k+1} (formulas at the top of this file).
+void swap_neighbours(const ReductionView& v, Eigen::Index k, double delta) {
+  const Eigen::Index n = v.n;
+  const double mu = v.L[(k + 1) + k * n];
+  const double d_k = v.d[k];
+  const double d_k1 = v.d[k + 1];
+  const double eta = d_k / delta;
+  const double lambda = d_k1 * mu / delta;
+  for (Eigen::Index j = 0; j < k; ++j) {
+    double& row_k = v.L[k + j * n];
+    double& row_k1 = v.L[(k + 1) + j * n];
+    const double old_k = row_k;
+    row_k = row_k1 - mu * old_k;
+    row_k1 = eta * old_k + lambda * row_k1;
+  }
+  v.L[(k + 1) + k * n] = lambda;
+  std::swap_ranges(v.L + k * n + k + 2, v.L + k * n + n, v.L + (k + 1) * n + k + 2);
+  v.d[k] = eta * d_k1;
+  v.d[k + 1] = delta;
+  std::swap_ranges(v.Z + k * n, v.Z + (k + 1) * n, v.Z + (k + 1) * n);
+  if (v.Z_inv_T != nullptr) {
+    std::swap_ranges(v.Z_inv_T + k * n, v.Z_inv_T + (k + 1) * n, v.Z_inv_T + (k + 1) * n);
+  } else {
+    v.log->push_back({k + 1, k, 0.0});
+  }
+  if (v.z_hat != nullptr) std::swap(v.z_hat[k], v.z_hat[k + 1]);
 }
 
-/// MLAMBDA reduction (decorrelation) of an already factorised problem.
-Status reduce(Decorrelation& dec, Eigen::VectorXd* z_hat) {
-  const Eigen::Index n = dec.L.rows();
+/// Reduction (decorrelation) of an already factorised problem: the swaps of MLAMBDA's reduction, with only the
+/// sub-diagonal entry size-reduced before each swap test and one size-reduction pass at the end (see the contract).
+Status reduce(const ReductionView& v) {
+  const Eigen::Index n = v.n;
   Eigen::Index k = n - 2;
-  Eigen::Index last_swap = n - 2;  // columns > last_swap are still size-reduced (lazy transformations)
   std::int64_t steps = 0;
   while (k >= 0) {
     if (++steps > kMaxReductionSteps) {
       return Error("mlambda: reduction did not terminate within " + std::to_string(kMaxReductionSteps) + " steps");
     }
-    if (k <= last_swap) {
-      for (Eigen::Index i = k + 1; i < n; ++i) gauss_transform(dec, i, k, z_hat);
-    }
-    const double mu = dec.L(k + 1, k);
-    const double delta = dec.d(k) + mu * mu * dec.d(k + 1);
-    if (delta < (1.0 - kSwapTolerance) * dec.d(k + 1)) {
-      swap_neighbours(dec, k, delta, z_hat);
-      last_swap = k;
+    gauss_transform(v, k + 1, k);
+    const double mu = v.L[(k + 1) + k * n];
+    const double delta = v.d[k] + mu * mu * v.d[k + 1];
+    if (delta < (1.0 - kSwapTolerance) * v.d[k + 1]) {
+      // The swap moves column k below row k + 1 into column k + 1: size-reduce it first so that unreduced entries
+      // cannot grow over repeated swaps (the instability of reducing the sub-diagonal only). Leaves L_{k+1,k}, d.
+      for (Eigen::Index i = k + 2; i < n; ++i) gauss_transform(v, i, k);
+      swap_neighbours(v, k, delta);
       k = n - 2;
     } else {
       --k;
     }
   }
+  // Size reduction: |L_ik| <= 1/2 for all i > k. Column k is reduced from the top (i = k + 1 first): G_ik changes
+  // only rows >= i of column k, which are reduced afterwards; d and the columns > k are untouched.
+  for (Eigen::Index col = n - 2; col >= 0; --col) {
+    for (Eigen::Index i = col + 1; i < n; ++i) gauss_transform(v, i, col);
+  }
   return Ok{};
 }
 
-struct Candidate {
-  double squared_norm;
-  Eigen::VectorXd z;
-};
+/// Factorisation and reduction into dec. With log == nullptr, dec.Z_inv receives Z^{-T}; otherwise dec.Z_inv is
+/// left empty and the operations are logged (with the initial permutation) for back_transform().
+Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, Eigen::VectorXd* z_hat,
+                        const Eigen::VectorXd* a_centred, std::vector<Eigen::Index>* perm,
+                        std::vector<ElementaryOperation>* log) {
+  const Eigen::Index n = Q_a.rows();
+  dec.L.resize(n, n);
+  dec.d.resize(n);
+  dec.Z.resize(n, n);
+  if (log == nullptr) dec.Z_inv.resize(n, n);
+  ReductionView v{n,       dec.L.data(), dec.d.data(), dec.Z.data(), log == nullptr ? dec.Z_inv.data() : nullptr,
+                  nullptr, perm,         log};
+  Eigen::MatrixXd W;
+  if (auto s = factorise_with_pivoting(Q_a, W, v); !s) return s;
+  if (z_hat != nullptr) {
+    *z_hat = dec.Z.transpose() * *a_centred;
+    v.z_hat = z_hat->data();
+  }
+  return reduce(v);
+}
 
 double sign_toward(double y) {
   return y <= 0.0 ? -1.0 : 1.0;
 }
 
-/// Schnorr-Euchner depth-first search with shrinking ellipsoid in the decorrelated space.
-Result<std::vector<Candidate>> search(const Decorrelation& dec, const Eigen::VectorXd& z_hat, int m,
-                                      std::int64_t max_nodes, std::int64_t& nodes_used) {
+/// The m best leaves of the search: z vectors in the columns of z, squared norms alongside (unsorted).
+struct BestLeaves {
+  Eigen::MatrixXd z;
+  Eigen::VectorXd squared_norms;
+  int count = 0;
+};
+
+/// Schnorr-Euchner depth-first search with shrinking ellipsoid in the decorrelated space. All storage is allocated
+/// before the loop; the loop itself works on raw arrays.
+Result<BestLeaves> search(const Decorrelation& dec, const Eigen::VectorXd& z_hat, int m, std::int64_t max_nodes,
+                          std::int64_t& nodes_used) {
   const Eigen::Index n = dec.L.rows();
-  const Eigen::MatrixXd& L = dec.L;
-  const Eigen::VectorXd& d = dec.d;
-  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, n);  // S(k, 0:k) = sum_{j>k} L(j, 0:k) (z_j - zbar_j)
-  Eigen::VectorXd partial(n + 1);                   // partial(k) = sum_{j>k} (z_j - zbar_j)^2 / d_j
-  Eigen::VectorXd z_bar(n), z(n), step(n);
-  std::vector<Candidate> best;
-  best.reserve(static_cast<std::size_t>(m));
+  const Eigen::MatrixXd L_T = dec.L.transpose();  // column k + 1 = row k + 1 of L, contiguous
+  const double* Lt = L_T.data();
+  const double* d = dec.d.data();
+  const double* zh = z_hat.data();
+  // S_T column k holds S(k, 0:k) = sum_{j>k} L(j, 0:k) (z_j - zbar_j): S_T[i + k n] = S(k, i).
+  Eigen::MatrixXd S_T = Eigen::MatrixXd::Zero(n, n);
+  double* S = S_T.data();
+  Eigen::VectorXd storage(4 * n + 1);
+  double* partial = storage.data();  // partial[k] = sum_{j>k} (z_j - zbar_j)^2 / d_j
+  double* z_bar = partial + n + 1;
+  double* z = z_bar + n;
+  double* step = z + n;
+  BestLeaves best;
+  best.z.resize(n, m);
+  best.squared_norms.resize(m);
+  double* best_norms = best.squared_norms.data();
+  int worst = 0;  // index of the largest norm among the m kept, once m are kept
   double radius = std::numeric_limits<double>::infinity();
 
   Eigen::Index k = n - 1;
-  partial(k) = 0.0;
-  z_bar(k) = z_hat(k);
-  z(k) = std::round(z_bar(k));
-  double y = z_bar(k) - z(k);
-  step(k) = sign_toward(y);
+  partial[k] = 0.0;
+  z_bar[k] = zh[k];
+  z[k] = std::round(z_bar[k]);
+  double y = z_bar[k] - z[k];
+  step[k] = sign_toward(y);
   nodes_used = 0;
   while (true) {
     if (++nodes_used > max_nodes) {
       return Error("mlambda: search exceeded the cap of " + std::to_string(max_nodes) +
                    " nodes (options.max_search_nodes)");
     }
-    const double dist = partial(k) + y * y / d(k);
+    const double dist = partial[k] + y * y / d[k];
     if (dist < radius) {
       if (k != 0) {
+        const double c = z[k] - z_bar[k];
         --k;
-        partial(k) = dist;
-        S.row(k).head(k + 1) = S.row(k + 1).head(k + 1) + (z(k + 1) - z_bar(k + 1)) * L.row(k + 1).head(k + 1);
-        z_bar(k) = z_hat(k) + S(k, k);
-        z(k) = std::round(z_bar(k));
-        y = z_bar(k) - z(k);
-        step(k) = sign_toward(y);
+        partial[k] = dist;
+        double* S_k = S + k * n;
+        const double* S_k1 = S + (k + 1) * n;
+        const double* L_row = Lt + (k + 1) * n;  // L(k + 1, 0:k)
+        for (Eigen::Index i = 0; i <= k; ++i) S_k[i] = S_k1[i] + c * L_row[i];
+        z_bar[k] = zh[k] + S_k[k];
+        z[k] = std::round(z_bar[k]);
+        y = z_bar[k] - z[k];
+        step[k] = sign_toward(y);
         continue;
       }
       // Leaf: keep the m best, shrink the ellipsoid to the m-th best once m are known.
-      if (static_cast<int>(best.size()) < m) {
-        best.push_back({dist, z});
-      } else {
-        auto worst = std::max_element(best.begin(), best.end(), [](const Candidate& l, const Candidate& r) {
-          return l.squared_norm < r.squared_norm;
-        });
-        *worst = {dist, z};
-      }
-      if (static_cast<int>(best.size()) == m) {
-        radius = std::max_element(best.begin(), best.end(), [](const Candidate& l, const Candidate& r) {
-                   return l.squared_norm < r.squared_norm;
-                 })->squared_norm;
+      const int slot = best.count < m ? best.count++ : worst;
+      std::copy(z, z + n, best.z.col(slot).data());
+      best_norms[slot] = dist;
+      if (best.count == m) {
+        worst = static_cast<int>(std::max_element(best_norms, best_norms + m) - best_norms);
+        radius = best_norms[worst];
       }
     } else {
       if (k == n - 1) break;
       ++k;
     }
     // Next value of z_k in zig-zag order around z_bar_k.
-    z(k) += step(k);
-    y = z_bar(k) - z(k);
-    step(k) = -step(k) - sign_toward(step(k));
+    z[k] += step[k];
+    y = z_bar[k] - z[k];
+    step[k] = -step[k] - sign_toward(step[k]);
   }
-  std::sort(best.begin(), best.end(),
-            [](const Candidate& l, const Candidate& r) { return l.squared_norm < r.squared_norm; });
   return best;
 }
 
@@ -264,8 +374,8 @@ Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a) {
   if (!Q_a.allFinite()) return Error("decorrelate: Q_a has a non-finite entry");
   if (auto s = check_symmetric(Q_a, "decorrelate"); !s) return s.error();
   Decorrelation dec;
-  if (auto s = factorise_with_pivoting(Q_a, dec); !s) return s.error();
-  if (auto s = reduce(dec, nullptr); !s) return s.error();
+  if (auto s = decorrelate_into(Q_a, dec, nullptr, nullptr, nullptr, nullptr); !s) return s.error();
+  dec.Z_inv.transposeInPlace();
   return dec;
 }
 
@@ -275,23 +385,31 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
   if (auto s = check_problem(a_float, Q_a, "mlambda"); !s) return s.error();
   if (auto s = check_symmetric(Q_a, "mlambda"); !s) return s.error();
 
-  Decorrelation dec;
-  if (auto s = factorise_with_pivoting(Q_a, dec); !s) return s.error();
+  Decorrelation dec;  // dec.Z_inv stays empty: the candidates are back-transformed through the operation log
   const Eigen::VectorXd shift = a_float.array().round().matrix();
-  Eigen::VectorXd z_hat = dec.Z.transpose() * (a_float - shift);
-  if (auto s = reduce(dec, &z_hat); !s) return s.error();
+  const Eigen::VectorXd a_centred = a_float - shift;
+  Eigen::VectorXd z_hat;
+  std::vector<Eigen::Index> perm;
+  std::vector<ElementaryOperation> log;
+  log.reserve(1024);
+  if (auto s = decorrelate_into(Q_a, dec, &z_hat, &a_centred, &perm, &log); !s) return s.error();
 
   IntegerSearchResult out;
   auto found = search(dec, z_hat, options.num_candidates, options.max_search_nodes, out.search_nodes);
   if (!found) return found.error();
+  const int m = found->count;
+  std::vector<int> order(static_cast<std::size_t>(m));
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](int l, int r) { return found->squared_norms(l) < found->squared_norms(r); });
   const Eigen::Index n = a_float.size();
-  const auto m = static_cast<Eigen::Index>(found->size());
   out.candidates.resize(n, m);
   out.squared_norms.resize(m);
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const Candidate& c = (*found)[static_cast<std::size_t>(j)];
-    out.candidates.col(j) = dec.Z_inv.transpose() * c.z + shift;  // exact: integer matrix times integer vector
-    out.squared_norms(j) = c.squared_norm;
+  for (int j = 0; j < m; ++j) {
+    const int from = order[static_cast<std::size_t>(j)];
+    back_transform(log, perm, found->z.col(from).data(), out.candidates.col(j).data());  // exact: integers
+    out.candidates.col(j) += shift;
+    out.squared_norms(j) = found->squared_norms(from);
   }
   out.Z = std::move(dec.Z);
   return out;
