@@ -126,7 +126,8 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("max_code_innovation_m", o.max_code_innovation_m);
   map.get("hold_sigma_cyc", o.hold_sigma_cyc);
   map.get("max_outage_s", o.max_outage_s);
-  map.get("slip_gf_threshold_m", o.slip_gf_threshold_m);
+  map.get("slip_gf_threshold_m", o.slips.gf_threshold_m);
+  map.get("slip_doppler", o.slips.use_doppler);
   std::string tropo = o.troposphere_saastamoinen ? "saastamoinen" : "off";
   map.get("troposphere", tropo);
   if (tropo != "saastamoinen" && tropo != "off") {
@@ -289,7 +290,8 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "max_code_innovation_m" << YAML::Value << o.max_code_innovation_m;
   out << YAML::Key << "hold_sigma_cyc" << YAML::Value << o.hold_sigma_cyc;
   out << YAML::Key << "max_outage_s" << YAML::Value << o.max_outage_s;
-  out << YAML::Key << "slip_gf_threshold_m" << YAML::Value << o.slip_gf_threshold_m;
+  out << YAML::Key << "slip_gf_threshold_m" << YAML::Value << o.slips.gf_threshold_m;
+  out << YAML::Key << "slip_doppler" << YAML::Value << o.slips.use_doppler;
   out << YAML::Key << "troposphere" << YAML::Value << (o.troposphere_saastamoinen ? "saastamoinen" : "off");
   out << YAML::Key << "ionosphere" << YAML::Value
       << (o.ionosphere == rtk::IonosphereModel::Estimate ? "estimate" : "off");

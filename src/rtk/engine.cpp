@@ -141,12 +141,17 @@ std::string RtkOptions::validate() const {
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
   if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";
+  if (const std::string e = slips.validate(); !e.empty()) return "slips: " + e;
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
   return {};
 }
 
 RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides, Eigen::Vector3d p_E_base_m)
-    : options_(std::move(options)), eph_(ephemerides), p_E_base_m_(std::move(p_E_base_m)) {
+    : options_(std::move(options)),
+      eph_(ephemerides),
+      p_E_base_m_(std::move(p_E_base_m)),
+      rover_slips_(options_.slips),
+      base_slips_(options_.slips) {
   x_ = Eigen::VectorXd::Zero(num_kinematic_states());
   P_ = Eigen::MatrixXd::Zero(num_kinematic_states(), num_kinematic_states());
 }
@@ -224,37 +229,14 @@ void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp
   last_time_ = t;
 }
 
-void RtkEngine::detect_slips(const std::vector<SingleDiff>& sds, const core::GpsTime& t) {
-  for (const SingleDiff& sd : sds) {
-    if (!core::has_value(sd.phase_m)) continue;
-    const AmbiguityKey key{sd.sat, sd.frequency};
-    const auto info = ambiguity_info_.find(key);
-    if (info == ambiguity_info_.end()) continue;
-    bool slip = (sd.lli & core::kLliLossOfLock) != 0;
-    if (t - info->second.last_seen > options_.max_outage_s) slip = true;
-    if (slip) remove_ambiguity(key);
+void RtkEngine::detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base) {
+  std::vector<SlipEvent> events = rover_slips_.update(rover);
+  if (!last_base_time_ || std::abs(base.time - *last_base_time_) > 1e-6) {
+    const std::vector<SlipEvent> base_events = base_slips_.update(base);
+    events.insert(events.end(), base_events.begin(), base_events.end());
+    last_base_time_ = base.time;
   }
-  // Geometry-free combination of the SD phases (model terms cancel): a jump is a slip on one of the two
-  // frequencies of one of the receivers, which cannot be told apart, so both ambiguities are reset.
-  for (const SingleDiff& sd : sds) {
-    if (sd.frequency != 0 || !core::has_value(sd.phase_m)) continue;
-    const SingleDiff* second = nullptr;
-    for (const SingleDiff& other : sds) {
-      if (other.sat == sd.sat && other.frequency > 0 && core::has_value(other.phase_m)) {
-        second = &other;
-        break;
-      }
-    }
-    if (second == nullptr) continue;
-    const double gf_m = sd.phase_m - second->phase_m;
-    auto& last = gf_by_satellite_[sd.sat];
-    if (core::has_value(last.first) && t - last.second < kGfSlipMaxGapS &&
-        std::abs(gf_m - last.first) > options_.slip_gf_threshold_m) {
-      remove_ambiguity({sd.sat, 0});
-      remove_ambiguity({sd.sat, second->frequency});
-    }
-    last = {gf_m, t};
-  }
+  for (const SlipEvent& e : events) remove_ambiguity({e.sat, e.frequency});
 }
 
 void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t) {
@@ -276,7 +258,9 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     AmbiguityInfo& a = ambiguity_info_[key];
     a.last_seen = t;
     ++a.lock_epochs;
-    const bool half_cycle = (sd.lli & core::kLliHalfCycle) != 0;
+    const bool half_cycle = (sd.lli & core::kLliHalfCycle) != 0 ||
+                            rover_slips_.half_cycle_unresolved(sd.sat, sd.frequency) ||
+                            base_slips_.half_cycle_unresolved(sd.sat, sd.frequency);
     const bool glonass_ok = sd.sat.system != Constellation::Glonass || options_.glonass_ar;
     sd.fixable = !half_cycle && glonass_ok && a.lock_epochs > options_.min_lock_epochs &&
                  sd.elevation_rad >= options_.ar_elevation_mask_rad;
@@ -525,11 +509,12 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
 
   if (options_.ar_mode == ArMode::Instantaneous) {
     while (!ambiguity_keys_.empty()) remove_ambiguity(ambiguity_keys_.back());
-    gf_by_satellite_.clear();
   }
   time_update(rover.time, *spp);
-  std::vector<SingleDiff> sds = single_differences(rover, *base);
-  detect_slips(sds, rover.time);
+  const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
+  const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
+  detect_slips(rover_obs, base_obs);
+  std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs);
   update_ambiguities(sds, rover.time);
   out.num_dd_measurements = measurement_update(sds, out.rejected);
   if (out.num_dd_measurements == 0) {
@@ -548,9 +533,8 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   return out;
 }
 
-std::vector<SingleDiff> RtkEngine::single_differences(const core::ObsEpoch& rover, const core::ObsEpoch& base) const {
-  const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
-  const ReceiverObservables base_obs = select_observables(base, eph_, options_.observables);
+std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables& rover_obs,
+                                                      const ReceiverObservables& base_obs) const {
   const Eigen::Vector3d p_E_u = x_.head<3>();
   const core::Geodetic g_u = core::ecef_to_geodetic(p_E_u);
   const core::Geodetic g_b = core::ecef_to_geodetic(p_E_base_m_);
@@ -568,8 +552,9 @@ std::vector<SingleDiff> RtkEngine::single_differences(const core::ObsEpoch& rove
       current = r.sat;
       const double pr_r = any_pseudorange(rover_obs, r.sat);
       const double pr_b = any_pseudorange(base_obs, r.sat);
-      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover.time, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
-      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base.time, pr_b, p_E_base_m_, g_b, tropo) : ZeroDiff{};
+      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover_obs.time, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
+      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base_obs.time, pr_b, p_E_base_m_, g_b, tropo)
+                                 : ZeroDiff{};
     }
     if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
     SingleDiff sd;

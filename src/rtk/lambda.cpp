@@ -21,6 +21,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <ranges>
 #include <string>
 
 #include <Eigen/Cholesky>
@@ -73,11 +74,11 @@ struct ElementaryOperation {
 /// operation as accumulating Z^{-1} would be. (I - mu e_i e_k^T)^{-T} = I + mu e_k e_i^T.
 void back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm, double* z,
                     double* a) {
-  for (auto op = log.rbegin(); op != log.rend(); ++op) {
-    if (op->mu == 0.0) {
-      std::swap(z[op->k], z[op->i]);
+  for (const ElementaryOperation& op : std::views::reverse(log)) {
+    if (op.mu == 0.0) {
+      std::swap(z[op.k], z[op.i]);
     } else {
-      z[op->k] += op->mu * z[op->i];
+      z[op.k] += op.mu * z[op.i];
     }
   }
   for (std::size_t i = 0; i < perm.size(); ++i) a[perm[i]] = z[i];

@@ -136,7 +136,10 @@ EnumerationBest enumerate_two_best(const Eigen::VectorXd& a_hat, const Eigen::Ma
     const long double r = R_red(level, level);
     const long double centre = centre_times_r / r;
     const long double half_width = std::sqrt(std::max(bound - partial, 0.0L)) / std::abs(r);
-    for (long double v = std::ceil(centre - half_width); v <= std::floor(centre + half_width); v += 1.0L) {
+    const auto first = static_cast<long long>(std::ceil(centre - half_width));
+    const auto last = static_cast<long long>(std::floor(centre + half_width));
+    for (long long candidate = first; candidate <= last; ++candidate) {
+      const auto v = static_cast<long double>(candidate);
       const long double residual = r * v - centre_times_r;
       const long double norm = partial + residual * residual;
       if (norm > bound) continue;

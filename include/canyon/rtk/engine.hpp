@@ -18,6 +18,10 @@
 //   sigma_phase^2 = a^2 + b^2 / sin^2(el),  sigma_code = code_phase_ratio * sigma_phase.
 // The DD covariance follows from the SD variances (correlated through the reference satellite).
 //
+// Cycle slips: each receiver's phases go through a CycleSlipDetector (loss of lock, half-cycle changes,
+// geometry-free jumps, Doppler against phase, outages); a slip at either receiver re-initialises the SD ambiguity,
+// and an unresolved half cycle at either receiver keeps it from being fixed.
+//
 // Time update: without dynamics (RTKLIB's "dynamics off") the position is re-initialised each epoch from the
 // single-point solution with a large variance; with dynamics a constant-acceleration model with white jerk.
 // Ambiguities carry over with a small random walk.
@@ -40,6 +44,7 @@
 #include "canyon/core/solution.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/gnss/spp.hpp"
+#include "canyon/rtk/cycle_slip.hpp"
 #include "canyon/rtk/observables.hpp"
 
 namespace canyon::rtk {
@@ -76,7 +81,7 @@ struct RtkOptions {
   double max_code_innovation_m = 100.0;       ///< DD code innovations beyond are rejected as outliers
   double hold_sigma_cyc = 0.001;              ///< fix-and-hold pseudo-measurement sigma (cycles)
   double max_outage_s = 5.0;                  ///< an ambiguity not observed for longer is re-initialised
-  double slip_gf_threshold_m = 0.05;          ///< geometry-free phase jump counted as a cycle slip (m)
+  CycleSlipOptions slips;                     ///< cycle-slip detection at each receiver
   bool troposphere_saastamoinen = true;       ///< model the troposphere at each receiver (off: data without one)
   IonosphereModel ionosphere = IonosphereModel::Off;  ///< differential ionosphere model
   double iono_sigma_per_10km_m = 0.03;  ///< prior sigma of a SD ionosphere state per 10 km of baseline (m)
@@ -115,9 +120,11 @@ class RtkEngine {
     double gf_m = core::kNoValue;  // last geometry-free combination (rover - base SD), for slip detection
   };
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
-  [[nodiscard]] std::vector<SingleDiff> single_differences(const core::ObsEpoch& rover,
-                                                           const core::ObsEpoch& base) const;
-  void detect_slips(const std::vector<SingleDiff>& sds, const core::GpsTime& t);
+  [[nodiscard]] std::vector<SingleDiff> single_differences(const ReceiverObservables& rover,
+                                                           const ReceiverObservables& base) const;
+  /// Runs both receivers' slip detectors and re-initialises the ambiguities that slipped; the base detector sees
+  /// each base epoch once (a base slower than the rover repeats its epochs).
+  void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
   void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
   /// EKF update with the DD code and phase; returns the number of DD phase rows used.
   int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
@@ -150,7 +157,9 @@ class RtkEngine {
   std::optional<core::GpsTime> last_time_;
   bool initialised_ = false;
   std::optional<Eigen::Vector3d> last_spp_p_E_m_;
-  std::map<core::SatelliteId, std::pair<double, core::GpsTime>> gf_by_satellite_;  // last SD geometry-free (m)
+  CycleSlipDetector rover_slips_;
+  CycleSlipDetector base_slips_;
+  std::optional<core::GpsTime> last_base_time_;
 
   friend class RtkEngineAccess;  // tests
 };
