@@ -74,7 +74,8 @@ struct ElementaryOperation {
 /// operation as accumulating Z^{-1} would be. (I - mu e_i e_k^T)^{-T} = I + mu e_k e_i^T.
 void back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm, double* z,
                     double* a) {
-  for (const ElementaryOperation& op : std::views::reverse(log)) {
+  for (std::size_t k = log.size(); k-- > 0;) {  // newest first (no ranges: clang-tidy 14 cannot parse them)
+    const ElementaryOperation& op = log[k];
     if (op.mu == 0.0) {
       std::swap(z[op.k], z[op.i]);
     } else {
