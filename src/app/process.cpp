@@ -8,6 +8,7 @@
 #include "canyon/core/geodesy.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/gnss/spp.hpp"
+#include "canyon/io/nmea.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
 #include "canyon/rtk/engine.hpp"
@@ -67,6 +68,23 @@ core::Solution to_solution(const gnss::SppSolution& spp) {
   return s;
 }
 
+/// The solution outputs: the .pos file and, when configured, NMEA GGA.
+struct Outputs {
+  io::PosWriter pos;
+  std::optional<io::NmeaWriter> nmea;
+
+  Status write(const core::Solution& solution, double hdop) {
+    if (Status s = pos.write(solution); !s) return s;
+    if (nmea) return nmea->write(solution, hdop);
+    return Ok{};
+  }
+  Status close() {
+    if (Status s = pos.close(); !s) return s;
+    if (nmea) return nmea->close();
+    return Ok{};
+  }
+};
+
 void add_unsolved(ProcessSummary& summary, const core::GpsTime& t, const std::string& reason) {
   if (summary.unsolved_reasons.size() >= kMaxUnsolvedReasons) return;
   char when[48];
@@ -75,7 +93,7 @@ void add_unsolved(ProcessSummary& summary, const core::GpsTime& t, const std::st
 }
 
 Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
-               const std::vector<core::ObsEpoch>& rover, io::PosWriter& writer, ProcessSummary& summary,
+               const std::vector<core::ObsEpoch>& rover, Outputs& writer, ProcessSummary& summary,
                const ProgressFn& progress) {
   std::optional<Eigen::Vector3d> last_p_E;
   const int total = static_cast<int>(rover.size());
@@ -84,7 +102,7 @@ Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
     auto sol = gnss::solve_spp(epoch, ephemerides, config.spp, last_p_E);
     if (sol) {
       last_p_E = sol->p_E_m;
-      if (Status w = writer.write(to_solution(*sol)); !w) return w.error();
+      if (Status w = writer.write(to_solution(*sol), sol->dop.hdop); !w) return w.error();
       ++summary.solved;
     } else {
       add_unsolved(summary, epoch.time, sol.error().message);
@@ -96,8 +114,7 @@ Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
 
 Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
                const std::vector<core::ObsEpoch>& rover, const std::vector<core::ObsEpoch>& base,
-               const Eigen::Vector3d& p_E_base, io::PosWriter& writer, ProcessSummary& summary,
-               const ProgressFn& progress) {
+               const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary, const ProgressFn& progress) {
   rtk::RtkOptions options = config.rtk;
   rtk::RtkEngine engine(options, ephemerides, p_E_base);
   std::size_t cursor = 0;
@@ -106,7 +123,7 @@ Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
     ++summary.epochs;
     auto result = engine.process(epoch, base_epoch_at(base, cursor, epoch.time));
     if (result) {
-      if (Status w = writer.write(result->solution); !w) return w.error();
+      if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
       ++summary.solved;
       if (result->solution.status == core::SolutionStatus::Fixed) ++summary.fixed;
       if (result->solution.status != core::SolutionStatus::Fixed) add_unsolved(summary, epoch.time, result->note);
@@ -157,14 +174,20 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
     base = std::move(*base_file);
   }
 
-  auto writer = io::PosWriter::create(config.out, {config.coordinates, config.time_format, header_lines(config)});
-  if (!writer) return writer.error();
+  auto pos = io::PosWriter::create(config.out, {config.coordinates, config.time_format, header_lines(config)});
+  if (!pos) return pos.error();
+  Outputs outputs{std::move(*pos), std::nullopt};
+  if (!config.nmea_out.empty()) {
+    auto nmea = io::NmeaWriter::create(config.nmea_out);
+    if (!nmea) return nmea.error();
+    outputs.nmea = std::move(*nmea);
+  }
   const Status run =
       config.mode == ProcessMode::Rtk
-          ? run_rtk(config, ephemerides, rover->epochs, base->epochs, p_E_base, *writer, summary, progress)
-          : run_spp(config, ephemerides, rover->epochs, *writer, summary, progress);
+          ? run_rtk(config, ephemerides, rover->epochs, base->epochs, p_E_base, outputs, summary, progress)
+          : run_spp(config, ephemerides, rover->epochs, outputs, summary, progress);
   if (!run) return run.error();
-  if (Status c = writer->close(); !c) return c.error();
+  if (Status c = outputs.close(); !c) return c.error();
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -230,6 +230,8 @@ Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::st
   for (std::string& n : c.nav) n = resolve(n, file);
   top.get("out", c.out);
   c.out = resolve(c.out, file);
+  top.get("nmea", c.nmea_out);
+  c.nmea_out = resolve(c.nmea_out, file);
   {
     YamlMap output = top.sub("output");
     std::string coordinates = c.coordinates == io::PosCoordinates::Llh ? "llh" : "ecef";
@@ -312,6 +314,7 @@ std::string to_yaml(const ProcessConfig& c) {
   }
   out << YAML::Key << "nav" << YAML::Value << YAML::Flow << c.nav;
   out << YAML::Key << "out" << YAML::Value << c.out;
+  if (!c.nmea_out.empty()) out << YAML::Key << "nmea" << YAML::Value << c.nmea_out;
   out << YAML::Key << "output" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "coordinates" << YAML::Value << (c.coordinates == io::PosCoordinates::Llh ? "llh" : "ecef");
   out << YAML::Key << "time_format" << YAML::Value

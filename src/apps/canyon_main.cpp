@@ -49,6 +49,7 @@ struct ProcessArgs {
   std::string exclude_sats;
   std::vector<std::string> nav;
   std::string out;
+  std::string nmea;
   std::string coordinates;
   std::string time_format;
   double elevation_mask_deg = -1.0;
@@ -68,6 +69,7 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   cmd->add_option("--exclude-sats", args.exclude_sats, "Satellites never used, e.g. G05,E11");
   cmd->add_option("--nav", args.nav, "RINEX navigation file (repeat for several)");
   cmd->add_option("--out", args.out, "Solution file, RTKLIB .pos format");
+  cmd->add_option("--nmea", args.nmea, "Also write the solutions as NMEA GGA sentences to this file");
   cmd->add_option("--coordinates", args.coordinates, "Output coordinates: llh or ecef")
       ->check(CLI::IsMember({"llh", "ecef"}));
   cmd->add_option("--time-format", args.time_format, "Output time: tow (GPST week, s) or calendar")
@@ -123,6 +125,7 @@ int run_process_command(const ProcessArgs& args) {
   }
   if (!args.nav.empty()) config.nav = args.nav;
   if (!args.out.empty()) config.out = args.out;
+  if (!args.nmea.empty()) config.nmea_out = args.nmea;
   if (!args.coordinates.empty()) {
     config.coordinates =
         args.coordinates == "ecef" ? canyon::io::PosCoordinates::Ecef : canyon::io::PosCoordinates::Llh;

@@ -496,6 +496,7 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   sol.P_E_m2 = spp->P_E_m2;
   sol.v_E_mps = spp->v_E_mps;
   sol.num_satellites = spp->num_satellites;
+  out.hdop = spp->dop.hdop;
   if (base == nullptr) {
     out.note = "no base observations";
     return out;

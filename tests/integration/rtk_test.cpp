@@ -13,6 +13,7 @@
 #include "canyon/core/geodesy.hpp"
 #include "canyon/eval/metrics.hpp"
 #include "canyon/eval/truth.hpp"
+#include "canyon/io/nmea.hpp"
 
 #include "test_support.hpp"
 
@@ -222,6 +223,32 @@ TEST(RtkBadInput, NoCommonSatellitesGivesSinglePointAndGoesOn) {
   EXPECT_EQ(run->summary.epochs, 60);
   EXPECT_EQ(run->summary.fixed, 0);
   EXPECT_EQ(run->solutions.size(), 60U);
+}
+
+}  // namespace
+}  // namespace canyon
+
+namespace canyon {
+namespace {
+
+TEST(RtkOutput, NmeaGgaBesideThePosFile) {
+  REQUIRE_DATA("cssrlib-static-doy078");
+  const fs::path nmea = test::temp_dir("rtk") / "static.nmea";
+  auto run = run_rtk("static_nmea", "cssrlib-static-doy078/SEPT078M1.21O", "cssrlib-static-doy078/3034078M1.21O",
+                     {"cssrlib-static-doy078/SEPT078M.21P"}, Eigen::Vector3d(-3959400.631, 3385704.533, 3667523.111),
+                     [&](app::ProcessConfig& c) { c.nmea_out = nmea.string(); });
+  ASSERT_TRUE(run.has_value());
+  std::ifstream in(nmea);
+  std::string line;
+  int sentences = 0;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    auto gga = io::parse_gga(line);
+    ASSERT_TRUE(gga.ok()) << line << ": " << gga.error().message;
+    EXPECT_EQ(gga->quality, 4) << line;  // RTK fixed
+    ++sentences;
+  }
+  EXPECT_EQ(sentences, 60);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 //   base_position: [X, Y, Z]       # base antenna ECEF (m); default: the base file's APPROX POSITION XYZ
 //   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
 //   out: SOL.pos                   # solution file (RTKLIB .pos format)
+//   nmea: SOL.nmea                 # also write NMEA GGA sentences (optional)
 //   output:
 //     coordinates: llh             # llh | ecef
 //     time_format: tow             # tow (GPST week, seconds) | calendar (yyyy/mm/dd hh:mm:ss.sss)
@@ -46,6 +47,7 @@ struct ProcessConfig {
   std::optional<Eigen::Vector3d> base_position_E_m;  ///< base antenna position (ECEF, m); header position if unset
   std::vector<std::string> nav;                      ///< navigation files
   std::string out;                                   ///< solution file
+  std::string nmea_out;                              ///< NMEA GGA file written beside the .pos when set
   io::PosCoordinates coordinates = io::PosCoordinates::Llh;
   io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
   gnss::SppOptions spp;

@@ -99,6 +99,7 @@ struct RtkEpoch {
   int num_dd_measurements = 0;              ///< DD phase measurements used in the update
   std::vector<core::SatelliteId> rejected;  ///< satellites whose measurements failed the innovation gate
   std::string note;                         ///< why the epoch is not fixed, if it is not (for --verbose)
+  double hdop = 0.0;                        ///< of the single-point geometry, for NMEA GGA
 };
 
 /// The RTK filter. Feed rover epochs in time order with the base epoch to use (nullptr if none).
