@@ -20,8 +20,6 @@ using core::Constellation;
 using core::SatelliteId;
 
 constexpr double kMaxBaseTimeAheadS = 0.05;      // base tags up to this much after the rover tag still count as "now"
-constexpr double kGfSlipMaxGapS = 60.0;          // beyond this the ionosphere can move the GF combination too much
-constexpr double kCodeInitVarianceFactor = 1.0;  // a new ambiguity's variance also covers the code noise
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {

@@ -118,7 +118,6 @@ class RtkEngine {
   struct AmbiguityInfo {
     int lock_epochs = 0;
     core::GpsTime last_seen;
-    double gf_m = core::kNoValue;  // last geometry-free combination (rover - base SD), for slip detection
   };
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
   [[nodiscard]] std::vector<SingleDiff> single_differences(const ReceiverObservables& rover,
@@ -162,7 +161,6 @@ class RtkEngine {
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;
 
-  friend class RtkEngineAccess;  // tests
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);
