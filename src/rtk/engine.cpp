@@ -19,7 +19,7 @@ namespace {
 using core::Constellation;
 using core::SatelliteId;
 
-constexpr double kMaxBaseTimeAheadS = 0.05;      // base tags up to this much after the rover tag still count as "now"
+constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {
@@ -139,6 +139,9 @@ std::string RtkOptions::validate() const {
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
   if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";
+  if (!(max_post_fit_sigmas > 0.0) || max_post_fit_rejections < 0) {
+    return "max_post_fit_sigmas must be > 0 and max_post_fit_rejections >= 0";
+  }
   if (const std::string e = slips.validate(); !e.empty()) return "slips: " + e;
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
   return {};
@@ -279,6 +282,30 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
 }
 
 int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected) {
+  // Update, then check the post-fit phase residuals: a signal whose residual is beyond the threshold (a phase
+  // inconsistent with the others, e.g. an undetected slip or signals two receivers track differently) is dropped for
+  // this epoch and the update redone from the prior.
+  const Eigen::VectorXd x0 = x_;
+  const Eigen::MatrixXd P0 = P_;
+  int used = 0;
+  for (int attempt = 0; attempt <= options_.max_post_fit_rejections; ++attempt) {
+    PostFit post_fit;
+    used = update_once(sds, rejected, post_fit);
+    if (post_fit.worst_sd < 0 || post_fit.worst_normalised <= options_.max_post_fit_sigmas ||
+        attempt == options_.max_post_fit_rejections) {
+      break;
+    }
+    SingleDiff& bad = sds[static_cast<std::size_t>(post_fit.worst_sd)];
+    rejected.push_back(bad.sat);
+    bad.ambiguity = -1;  // its phase is not used (nor fixed) this epoch
+    bad.fixable = false;
+    x_ = x0;
+    P_ = P0;
+  }
+  return used;
+}
+
+int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected, PostFit& post_fit) {
   // Group by (constellation, frequency); the reference is the highest satellite with the observable.
   const Eigen::Index n = x_.size();
   std::vector<DdRow> rows;
@@ -360,10 +387,26 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
   // Kalman update: K = P H^T S^-1.
   const Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success) return 0;
-  x_ += PHt * llt.solve(v);
   const Eigen::MatrixXd L_inv_HP = llt.matrixL().solve(PHt.transpose());  // L^-1 H P, m x n
+  const Eigen::VectorXd dx = PHt * llt.solve(v);
+  x_ += dx;
   P_.noalias() -= L_inv_HP.transpose() * L_inv_HP;
   P_ = 0.5 * (P_ + P_.transpose()).eval();
+  // Post-fit DD phase residuals, normalised by their measurement sigma: the worst one is reported.
+  post_fit = PostFit{};
+  for (Eigen::Index a = 0; a < m; ++a) {
+    const DdRow& row = rows[static_cast<std::size_t>(a)];
+    if (!row.phase) continue;
+    double h_dx = row.h_pos.dot(dx.head<3>());
+    for (int k = 0; k < row.num_entries; ++k) {
+      h_dx += row.entries[static_cast<std::size_t>(k)].second * dx[row.entries[static_cast<std::size_t>(k)].first];
+    }
+    const double normalised = std::abs(v[a] - h_dx) / std::sqrt(R(a, a));
+    if (normalised > post_fit.worst_normalised) {
+      post_fit.worst_normalised = normalised;
+      post_fit.worst_sd = row.sd;
+    }
+  }
   int phase_rows = 0;
   for (const DdRow& r : rows) phase_rows += r.phase ? 1 : 0;
   return phase_rows;

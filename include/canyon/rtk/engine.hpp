@@ -79,6 +79,8 @@ struct RtkOptions {
   double max_age_s = 30.0;                    ///< base observations older than this are not used
   double max_phase_innovation_m = 30.0;       ///< DD phase innovations beyond are rejected as outliers
   double max_code_innovation_m = 100.0;       ///< DD code innovations beyond are rejected as outliers
+  double max_post_fit_sigmas = 4.0;           ///< DD phase post-fit residuals beyond (in sigmas) are rejected
+  int max_post_fit_rejections = 3;            ///< at most this many signals rejected per epoch
   double hold_sigma_cyc = 0.001;              ///< fix-and-hold pseudo-measurement sigma (cycles)
   double max_outage_s = 5.0;                  ///< an ambiguity not observed for longer is re-initialised
   CycleSlipOptions slips;                     ///< cycle-slip detection at each receiver
@@ -126,8 +128,13 @@ class RtkEngine {
   /// each base epoch once (a base slower than the rover repeats its epochs).
   void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
   void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
-  /// EKF update with the DD code and phase; returns the number of DD phase rows used.
+  /// EKF update with the DD code and phase, with post-fit rejection; returns the number of DD phase rows used.
   int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
+  struct PostFit {
+    int worst_sd = -1;              // SD of the largest normalised post-fit phase residual
+    double worst_normalised = 0.0;  // |residual| / measurement sigma
+  };
+  int update_once(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected, PostFit& post_fit);
   /// A candidate fix of a set of DD ambiguities (state index of s, of its reference).
   struct Fix {
     Eigen::MatrixXd D;  // DD ambiguities = D x
@@ -160,7 +167,6 @@ class RtkEngine {
   CycleSlipDetector rover_slips_;
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;
-
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);
