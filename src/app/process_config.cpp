@@ -18,46 +18,12 @@ std::string resolve(const std::string& path, const std::string& file) {
   return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
 }
 
-std::vector<std::string> system_letters(const gnss::SppOptions& o) {
-  std::vector<std::string> out;
-  if (o.use_gps) out.emplace_back("G");
-  if (o.use_glonass) out.emplace_back("R");
-  if (o.use_galileo) out.emplace_back("E");
-  if (o.use_beidou) out.emplace_back("C");
-  if (o.use_qzss) out.emplace_back("J");
-  return out;
-}
-
-std::vector<std::string> system_letters(const rtk::ObservableOptions& o) {
-  std::vector<std::string> out;
-  if (o.use_gps) out.emplace_back("G");
-  if (o.use_glonass) out.emplace_back("R");
-  if (o.use_galileo) out.emplace_back("E");
-  if (o.use_beidou) out.emplace_back("C");
-  if (o.use_qzss) out.emplace_back("J");
-  return out;
-}
-
-/// Reads a list of system letters into the five flags; records an error for anything else.
-void parse_systems(YamlMap& map, std::vector<std::string> systems, bool& gps, bool& glonass, bool& galileo,
-                   bool& beidou, bool& qzss) {
+/// Reads `systems` (a list of constellation letters) into the flags; records an error for anything else.
+void parse_systems(YamlMap& map, core::ConstellationFlags& flags) {
+  std::vector<std::string> systems = flags.letters();
   map.get("systems", systems);
-  gps = glonass = galileo = beidou = qzss = false;
-  for (const std::string& s : systems) {
-    if (s == "G") {
-      gps = true;
-    } else if (s == "R") {
-      glonass = true;
-    } else if (s == "E") {
-      galileo = true;
-    } else if (s == "C") {
-      beidou = true;
-    } else if (s == "J") {
-      qzss = true;
-    } else {
-      map.fail("systems", "has '" + s + "'; allowed: G, R, E, C, J");
-    }
-  }
+  std::string bad;
+  if (!flags.set_from_letters(systems, &bad)) map.fail("systems", "has '" + bad + "'; allowed: G, R, E, C, J");
 }
 
 void parse_satellites(YamlMap& map, const std::string& key, std::vector<core::SatelliteId>& out) {
@@ -98,7 +64,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   }
   map.get("frequencies", o.observables.num_frequencies);
   rtk::ObservableOptions& obs = o.observables;
-  parse_systems(map, system_letters(obs), obs.use_gps, obs.use_glonass, obs.use_galileo, obs.use_beidou, obs.use_qzss);
+  parse_systems(map, obs);
   parse_satellites(map, "exclude", obs.excluded);
   parse_angle_deg(map, "elevation_mask_deg", o.elevation_mask_rad);
   parse_angle_deg(map, "ar_elevation_mask_deg", o.ar_elevation_mask_rad);
@@ -149,7 +115,7 @@ void parse_spp(YamlMap map, gnss::SppOptions& o) {
   double mask_deg = o.elevation_mask_rad * core::kRadToDeg;
   map.get("elevation_mask_deg", mask_deg);
   o.elevation_mask_rad = mask_deg * core::kDegToRad;
-  parse_systems(map, system_letters(o), o.use_gps, o.use_glonass, o.use_galileo, o.use_beidou, o.use_qzss);
+  parse_systems(map, o);
   std::string iono = o.ionosphere_klobuchar ? "klobuchar" : "off";
   map.get("ionosphere", iono);
   if (iono != "klobuchar" && iono != "off") map.fail("ionosphere", "must be klobuchar or off, not '" + iono + "'");
@@ -269,7 +235,7 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "rtk" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "ar_mode" << YAML::Value << rtk::ar_mode_name(o.ar_mode);
   out << YAML::Key << "frequencies" << YAML::Value << o.observables.num_frequencies;
-  out << YAML::Key << "systems" << YAML::Value << YAML::Flow << system_letters(o.observables);
+  out << YAML::Key << "systems" << YAML::Value << YAML::Flow << o.observables.letters();
   std::vector<std::string> excluded;
   for (const auto& sat : o.observables.excluded) excluded.push_back(sat.to_string());
   out << YAML::Key << "exclude" << YAML::Value << YAML::Flow << excluded;
@@ -327,7 +293,7 @@ std::string to_yaml(const ProcessConfig& c) {
   const gnss::SppOptions& s = c.spp;
   out << YAML::Key << "spp" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "elevation_mask_deg" << YAML::Value << s.elevation_mask_rad * core::kRadToDeg;
-  out << YAML::Key << "systems" << YAML::Value << YAML::Flow << system_letters(s);
+  out << YAML::Key << "systems" << YAML::Value << YAML::Flow << s.letters();
   out << YAML::Key << "ionosphere" << YAML::Value << (s.ionosphere_klobuchar ? "klobuchar" : "off");
   out << YAML::Key << "troposphere" << YAML::Value << (s.troposphere_saastamoinen ? "saastamoinen" : "off");
   out << YAML::Key << "code_sigma_m" << YAML::Value << s.code_sigma_m;

@@ -229,3 +229,47 @@ std::optional<int> frequency_rank(Constellation system, char band) {
 }
 
 }  // namespace canyon::core
+
+namespace canyon::core {
+
+bool ConstellationFlags::uses(Constellation c) const {
+  switch (c) {
+    case Constellation::Gps: return use_gps;
+    case Constellation::Glonass: return use_glonass;
+    case Constellation::Galileo: return use_galileo;
+    case Constellation::BeiDou: return use_beidou;
+    case Constellation::Qzss: return use_qzss;
+  }
+  return false;
+}
+
+std::vector<std::string> ConstellationFlags::letters() const {
+  std::vector<std::string> out;
+  for (int s = 0; s < kNumConstellations; ++s) {
+    const auto c = static_cast<Constellation>(s);
+    if (uses(c)) out.emplace_back(1, system_letter(c));
+  }
+  return out;
+}
+
+bool ConstellationFlags::set_from_letters(const std::vector<std::string>& letters, std::string* bad_letter) {
+  ConstellationFlags flags{false, false, false, false, false};
+  for (const std::string& l : letters) {
+    const auto c = l.size() == 1 && l[0] != ' ' ? constellation_from_letter(l[0]) : std::nullopt;
+    if (!c) {
+      if (bad_letter != nullptr) *bad_letter = l;
+      return false;
+    }
+    switch (*c) {
+      case Constellation::Gps: flags.use_gps = true; break;
+      case Constellation::Glonass: flags.use_glonass = true; break;
+      case Constellation::Galileo: flags.use_galileo = true; break;
+      case Constellation::BeiDou: flags.use_beidou = true; break;
+      case Constellation::Qzss: flags.use_qzss = true; break;
+    }
+  }
+  *this = flags;
+  return true;
+}
+
+}  // namespace canyon::core

@@ -65,17 +65,6 @@ std::string_view attribute_priority(Constellation system) {
   return "";
 }
 
-bool system_enabled(Constellation system, const SppOptions& o) {
-  switch (system) {
-    case Constellation::Gps: return o.use_gps;
-    case Constellation::Glonass: return o.use_glonass;
-    case Constellation::Galileo: return o.use_galileo;
-    case Constellation::BeiDou: return o.use_beidou;
-    case Constellation::Qzss: return o.use_qzss;
-  }
-  return false;
-}
-
 /// The first-frequency signal with a pseudorange, by attribute priority.
 const core::SignalObs* select_signal(const core::SatelliteObs& sat_obs) {
   const core::SignalObs* best = nullptr;
@@ -104,7 +93,7 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
   std::vector<Measurement> out;
   out.reserve(epoch.sats.size());
   for (const core::SatelliteObs& sat_obs : epoch.sats) {
-    if (!system_enabled(sat_obs.sat.system, options)) continue;
+    if (!options.uses(sat_obs.sat.system)) continue;
     if (std::find(options.excluded.begin(), options.excluded.end(), sat_obs.sat) != options.excluded.end()) continue;
     const core::SignalObs* signal = select_signal(sat_obs);
     if (signal == nullptr) continue;
@@ -322,7 +311,7 @@ std::string SppOptions::validate() const {
   if (max_iterations < 1) return "max_iterations must be >= 1";
   if (!(convergence_m > 0.0)) return "convergence_m must be > 0";
   if (!(max_gdop > 0.0)) return "max_gdop must be > 0";
-  if (!(use_gps || use_glonass || use_galileo || use_beidou || use_qzss)) return "at least one system must be used";
+  if (!any()) return "at least one system must be used";
   return {};
 }
 

@@ -13,17 +13,6 @@ namespace {
 
 using core::Constellation;
 
-bool system_enabled(Constellation system, const ObservableOptions& o) {
-  switch (system) {
-    case Constellation::Gps: return o.use_gps;
-    case Constellation::Glonass: return o.use_glonass;
-    case Constellation::Galileo: return o.use_galileo;
-    case Constellation::BeiDou: return o.use_beidou;
-    case Constellation::Qzss: return o.use_qzss;
-  }
-  return false;
-}
-
 /// Rank of a signal among the candidates of its (system, frequency): lower is better. Signals with carrier phase
 /// come first, then by code priority.
 int signal_rank(Constellation system, const core::SignalObs& s) {
@@ -83,7 +72,7 @@ ReceiverObservables select_observables(const core::ObsEpoch& epoch, const gnss::
   out.signals.reserve(epoch.sats.size() * static_cast<std::size_t>(options.num_frequencies));
   for (const core::SatelliteObs& sat_obs : epoch.sats) {
     const core::SatelliteId sat = sat_obs.sat;
-    if (!system_enabled(sat.system, options)) continue;
+    if (!options.uses(sat.system)) continue;
     if (std::find(options.excluded.begin(), options.excluded.end(), sat) != options.excluded.end()) continue;
     const int channel = sat.system == Constellation::Glonass ? eph.glonass_channel(sat.prn) : core::kNoGlonassChannel;
     std::array<const core::SignalObs*, kMaxFrequencies> best{};

@@ -81,3 +81,26 @@ TEST(SignalTest, FrequencyRanks) {
 
 }  // namespace
 }  // namespace canyon::core
+
+namespace canyon::core {
+namespace {
+
+TEST(ConstellationFlagsTest, LettersRoundTripAndRejectUnknown) {
+  ConstellationFlags flags;
+  EXPECT_EQ(flags.letters(), (std::vector<std::string>{"G", "R", "E", "C", "J"}));
+  ASSERT_TRUE(flags.set_from_letters({"E", "G"}));
+  EXPECT_TRUE(flags.uses(Constellation::Gps));
+  EXPECT_TRUE(flags.uses(Constellation::Galileo));
+  EXPECT_FALSE(flags.uses(Constellation::Glonass));
+  EXPECT_EQ(flags.letters(), (std::vector<std::string>{"G", "E"}));
+  std::string bad;
+  EXPECT_FALSE(flags.set_from_letters({"G", "S"}, &bad));
+  EXPECT_EQ(bad, "S");
+  EXPECT_EQ(flags.letters(), (std::vector<std::string>{"G", "E"}));  // unchanged on error
+  EXPECT_FALSE(flags.set_from_letters({"GR"}));
+  ASSERT_TRUE(flags.set_from_letters({}));
+  EXPECT_FALSE(flags.any());
+}
+
+}  // namespace
+}  // namespace canyon::core

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace canyon::core {
 
@@ -73,5 +74,26 @@ inline constexpr int kNoGlonassChannel = 99;
 ///   Galileo: E1 0, E5b 1, E5a 2, E6 3, E5 4; BeiDou: B1I 0, B2I/B2b 1, B3I 2, B1C 3, B2a 4, B2 5.
 /// nullopt for a band the system does not have.
 [[nodiscard]] std::optional<int> frequency_rank(Constellation system, char band);
+
+}  // namespace canyon::core
+
+namespace canyon::core {
+
+/// Which constellations a processing step uses. Options structs inherit it, so that `use_gps` etc. read as their own
+/// fields and the logic exists once.
+struct ConstellationFlags {
+  bool use_gps = true;
+  bool use_glonass = true;
+  bool use_galileo = true;
+  bool use_beidou = true;
+  bool use_qzss = true;
+
+  [[nodiscard]] bool uses(Constellation c) const;
+  [[nodiscard]] bool any() const { return use_gps || use_glonass || use_galileo || use_beidou || use_qzss; }
+  /// Letters of the constellations used, in G R E C J order.
+  [[nodiscard]] std::vector<std::string> letters() const;
+  /// Sets the flags from letters; false (flags unchanged) if a letter is not one of G R E C J.
+  [[nodiscard]] bool set_from_letters(const std::vector<std::string>& letters, std::string* bad_letter = nullptr);
+};
 
 }  // namespace canyon::core

@@ -26,13 +26,8 @@
 
 namespace canyon::gnss {
 
-struct SppOptions {
+struct SppOptions : core::ConstellationFlags {              // use_gps ... use_qzss: constellations used
   double elevation_mask_rad = 15.0 * 0.017453292519943295;  ///< satellites below are not used
-  bool use_gps = true;
-  bool use_glonass = true;
-  bool use_galileo = true;
-  bool use_beidou = true;
-  bool use_qzss = true;
   bool qzss_own_clock = false;       ///< false: QZSS shares the GPS receiver clock (same system time)
   bool ionosphere_klobuchar = true;  ///< false: no ionosphere model
   bool troposphere_saastamoinen = true;

@@ -46,14 +46,9 @@ struct ReceiverObservables {
   [[nodiscard]] const SignalObservable* find(core::SatelliteId sat, int frequency) const;
 };
 
-struct ObservableOptions {
-  int num_frequencies = 2;  ///< 1..3: how many frequency ranks to keep
-  bool use_gps = true;
-  bool use_glonass = true;
-  bool use_galileo = true;
-  bool use_beidou = true;
-  bool use_qzss = true;
-  std::vector<core::SatelliteId> excluded;  ///< never used
+struct ObservableOptions : core::ConstellationFlags {  // use_gps ... use_qzss: constellations used
+  int num_frequencies = 2;                             ///< 1..3: how many frequency ranks to keep
+  std::vector<core::SatelliteId> excluded;             ///< never used
 };
 
 /// Selects the observables of an epoch. GLONASS FDMA wavelengths use the channel from the ephemerides (a GLONASS
