@@ -13,10 +13,16 @@
 //   DD code:  (P_sd,s - P_sd,r)                       = DD rho(p_E_u) + e
 // with SD = rover - base, rho the geometric range with the Sagnac term, minus the satellite clock, plus the
 // Saastamoinen troposphere at each receiver (computed per receiver at its own transmission time, so that receivers
-// whose time tags differ by milliseconds difference correctly). Receiver clocks cancel in the double differences;
-// for short baselines the differential ionosphere is neglected. Zero-difference variance per receiver:
+// whose time tags differ by milliseconds difference correctly). Receiver clocks cancel in the double differences.
+// The differential ionosphere is neglected (short baselines) or, with IonosphereModel::Estimate, enters as
+// -mu_s I_sd,s + mu_r I_sd,r on phase and with the opposite sign on code, mu = (f_1 / f)^2. Zero-difference variance
+// per receiver:
 //   sigma_phase^2 = a^2 + b^2 / sin^2(el),  sigma_code = code_phase_ratio * sigma_phase.
 // The DD covariance follows from the SD variances (correlated through the reference satellite).
+//
+// Outliers: DD innovations beyond max_phase_innovation_m / max_code_innovation_m are not used; after the update,
+// a DD phase whose post-fit residual exceeds max_post_fit_sigmas is dropped for the epoch and the update redone from
+// the prior (at most max_post_fit_rejections times).
 //
 // Cycle slips: each receiver's phases go through a CycleSlipDetector (loss of lock, half-cycle changes,
 // geometry-free jumps, Doppler against phase, outages); a slip at either receiver re-initialises the SD ambiguity,
@@ -29,7 +35,9 @@
 // Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA, ratio test; the fixed position
 // from the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix). Modes: continuous, instantaneous (ambiguities
 // re-initialised every epoch), fix-and-hold (the fixed DD ambiguities fed back as pseudo-measurements with a small
-// variance). GLONASS ambiguities are fixed only when glonass_ar is on.
+// variance). When the whole set fails the ratio test, partial fixing tries it without each (constellation, frequency)
+// group in turn and keeps the passing fix with the highest ratio. GLONASS ambiguities are fixed only when glonass_ar
+// is on.
 
 #include <map>
 #include <optional>
