@@ -112,9 +112,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
 }
 
 void parse_spp(YamlMap map, gnss::SppOptions& o) {
-  double mask_deg = o.elevation_mask_rad * core::kRadToDeg;
-  map.get("elevation_mask_deg", mask_deg);
-  o.elevation_mask_rad = mask_deg * core::kDegToRad;
+  parse_angle_deg(map, "elevation_mask_deg", o.elevation_mask_rad);
   parse_systems(map, o);
   std::string iono = o.ionosphere_klobuchar ? "klobuchar" : "off";
   map.get("ionosphere", iono);

@@ -1,11 +1,8 @@
 #include "canyon/io/nmea.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <vector>
 
 #include "canyon/core/constants.hpp"
@@ -249,32 +246,15 @@ Result<GgaSentence> parse_gga(std::string_view sentence) {
 }
 
 Result<NmeaWriter> NmeaWriter::create(const std::string& path, core::LeapSecondTable leaps, GgaOptions options) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty()) {
-    std::error_code ignored;
-    std::filesystem::create_directories(parent, ignored);
-  }
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "wb"));
-  if (!file) return Error{std::string("cannot create NMEA file: ") + std::strerror(errno), path, 0};
-  return NmeaWriter(std::move(file), path, std::move(leaps), options);
+  auto file = TextFileWriter::create(path, "NMEA file");
+  if (!file) return file.error();
+  return NmeaWriter(std::move(*file), std::move(leaps), options);
 }
 
 Status NmeaWriter::write(const core::Solution& solution, std::optional<double> hdop) {
   GgaOptions options = options_;
   if (hdop) options.hdop = hdop;
-  const std::string sentence = format_gga(solution, leaps_, options);
-  if (std::fprintf(file_.get(), "%s\r\n", sentence.c_str()) < 0) {
-    return Error{std::string("cannot write NMEA sentence: ") + std::strerror(errno), path_, 0};
-  }
-  return Ok{};
-}
-
-Status NmeaWriter::close() {
-  if (!file_) return Ok{};
-  const bool failed = std::ferror(file_.get()) != 0;
-  std::FILE* f = file_.release();
-  if (std::fclose(f) != 0 || failed) return Error{"error writing NMEA file", path_, 0};
-  return Ok{};
+  return file_.write_line(format_gga(solution, leaps_, options), "\r\n");  // NMEA 0183 ends sentences in CR LF
 }
 
 }  // namespace canyon::io

@@ -2,10 +2,7 @@
 
 #include "canyon/io/pos_file.hpp"
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <sstream>
 
 #include "canyon/core/constants.hpp"
@@ -58,19 +55,21 @@ std::string column_titles(PosCoordinates coordinates, PosTimeFormat time_format)
 }  // namespace
 
 Result<PosWriter> PosWriter::create(const std::string& path, PosWriterOptions options) {
-  // Create the output folder as users expect; a failure shows up as the fopen error below.
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty()) {
-    std::error_code ignored;
-    std::filesystem::create_directories(parent, ignored);
+  auto file = TextFileWriter::create(path, "solution file");
+  if (!file) return file.error();
+  for (const std::string& line : options.header_lines) {
+    if (Status s = file->write_line("% " + line); !s) return s.error();
   }
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "w"));
-  if (!file) return Error{std::string("cannot create solution file: ") + std::strerror(errno), path, 0};
-  for (const std::string& line : options.header_lines) std::fprintf(file.get(), "%% %s\n", line.c_str());
-  std::fprintf(file.get(), "%%\n%% (%s,Q=1:fix,2:float,5:single,7:vio fill-in,ns=# of satellites)\n",
-               options.coordinates == PosCoordinates::Llh ? "lat/lon/height=WGS84/ellipsoidal" : "x/y/z-ecef=WGS84");
-  std::fprintf(file.get(), "%s\n", column_titles(options.coordinates, options.time_format).c_str());
-  return PosWriter(std::move(file), path, std::move(options));
+  const char* coordinates =
+      options.coordinates == PosCoordinates::Llh ? "lat/lon/height=WGS84/ellipsoidal" : "x/y/z-ecef=WGS84";
+  if (Status s = file->write_line("%"); !s) return s.error();
+  if (Status s = file->write_line(std::string("% (") + coordinates +
+                                  ",Q=1:fix,2:float,5:single,7:vio fill-in,ns=# of satellites)");
+      !s) {
+    return s.error();
+  }
+  if (Status s = file->write_line(column_titles(options.coordinates, options.time_format)); !s) return s.error();
+  return PosWriter(std::move(*file), std::move(options));
 }
 
 std::string format_pos_record(const core::Solution& s, PosCoordinates coordinates, PosTimeFormat time_format) {
@@ -124,19 +123,7 @@ std::string format_pos_record(const core::Solution& s, PosCoordinates coordinate
 }
 
 Status PosWriter::write(const core::Solution& solution) {
-  const std::string line = format_pos_record(solution, options_.coordinates, options_.time_format);
-  if (std::fprintf(file_.get(), "%s\n", line.c_str()) < 0) {
-    return Error{std::string("cannot write solution: ") + std::strerror(errno), path_, 0};
-  }
-  return Ok{};
-}
-
-Status PosWriter::close() {
-  if (!file_) return Ok{};
-  const bool failed = std::ferror(file_.get()) != 0;
-  std::FILE* f = file_.release();
-  if (std::fclose(f) != 0 || failed) return Error{"error writing solution file", path_, 0};
-  return Ok{};
+  return file_.write_line(format_pos_record(solution, options_.coordinates, options_.time_format));
 }
 
 Result<std::vector<core::Solution>> read_pos_file(const std::string& path) {

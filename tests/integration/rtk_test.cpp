@@ -57,7 +57,9 @@ std::optional<RtkRun> run_rtk(const std::string& name, const std::string& rover,
 }
 
 void expect_static_fixed(const RtkRun& run, const Eigen::Vector3d& truth, const std::string& name) {
-  auto stats = eval::evaluate(run.solutions, eval::Truth::constant(truth));
+  eval::EvalOptions options;
+  options.wrong_fix_threshold_m = kWrongFixM;
+  auto stats = eval::evaluate(run.solutions, eval::Truth::constant(truth), options);
   ASSERT_TRUE(stats.ok());
   std::cout << "[ RTK      ] " << name << ": " << stats->fixed().epochs << "/" << run.summary.epochs
             << " fixed, 3D RMSE " << stats->overall.rmse_3d_m << " m, first fix after "
@@ -127,8 +129,10 @@ TEST(RtkSimulator, InstinctBothVariantsBothRoversFixedWithinOneCentimetre) {
                 });
     ASSERT_TRUE(run.has_value());
     const bool dynamic = std::string(k.rover) == "dynamic";
-    auto stats = dynamic ? eval::evaluate(run->solutions, *dynamic_truth)
-                         : eval::evaluate(run->solutions, eval::Truth::constant(static_rover));
+    eval::EvalOptions options;
+    options.wrong_fix_threshold_m = kWrongFixM;
+    auto stats = dynamic ? eval::evaluate(run->solutions, *dynamic_truth, options)
+                         : eval::evaluate(run->solutions, eval::Truth::constant(static_rover), options);
     ASSERT_TRUE(stats.ok());
     std::cout << "[ RTK      ] instinct " << k.variant << " " << k.rover << ": " << stats->fixed().epochs << "/"
               << run->summary.epochs << " fixed, 3D RMSE " << stats->overall.rmse_3d_m << " m\n";

@@ -30,6 +30,7 @@
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
 #include "canyon/core/time.hpp"
+#include "canyon/io/text_file_writer.hpp"
 
 namespace canyon::io {
 
@@ -81,20 +82,13 @@ class NmeaWriter {
   /// One GGA sentence; `hdop` overrides the writer's GgaOptions::hdop for this solution.
   Status write(const core::Solution& solution, std::optional<double> hdop = std::nullopt);
   /// Flushes and closes; reports a write error (e.g. disk full) that happened on the way.
-  Status close();
+  Status close() { return file_.close(); }
 
  private:
-  struct FileCloser {
-    void operator()(std::FILE* f) const {
-      if (f != nullptr) std::fclose(f);
-    }
-  };
-  NmeaWriter(std::unique_ptr<std::FILE, FileCloser> file, std::string path, core::LeapSecondTable leaps,
-             GgaOptions options)
-      : file_(std::move(file)), path_(std::move(path)), leaps_(std::move(leaps)), options_(options) {}
+  NmeaWriter(TextFileWriter file, core::LeapSecondTable leaps, GgaOptions options)
+      : file_(std::move(file)), leaps_(std::move(leaps)), options_(options) {}
 
-  std::unique_ptr<std::FILE, FileCloser> file_;
-  std::string path_;
+  TextFileWriter file_;
   core::LeapSecondTable leaps_;
   GgaOptions options_;
 };

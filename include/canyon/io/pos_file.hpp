@@ -6,13 +6,12 @@
 // latitude/longitude (deg) and ellipsoidal height (m) with ENU standard deviations (sdn sde sdu sdne sdeu sdun; the
 // cross terms as sign(c) sqrt(|c|)), or ECEF x y z with sdx sdy sdz sdxy sdyz sdzx; then Q, ns, age (s), ratio.
 
-#include <cstdio>
-#include <memory>
 #include <string>
 #include <vector>
 
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
+#include "canyon/io/text_file_writer.hpp"
 
 namespace canyon::io {
 
@@ -35,19 +34,12 @@ class PosWriter {
 
   Status write(const core::Solution& solution);
   /// Flushes and closes; reports a write error (e.g. disk full) that happened on the way.
-  Status close();
+  Status close() { return file_.close(); }
 
  private:
-  struct FileCloser {
-    void operator()(std::FILE* f) const {
-      if (f != nullptr) std::fclose(f);
-    }
-  };
-  PosWriter(std::unique_ptr<std::FILE, FileCloser> file, std::string path, PosWriterOptions options)
-      : file_(std::move(file)), path_(std::move(path)), options_(std::move(options)) {}
+  PosWriter(TextFileWriter file, PosWriterOptions options) : file_(std::move(file)), options_(std::move(options)) {}
 
-  std::unique_ptr<std::FILE, FileCloser> file_;
-  std::string path_;
+  TextFileWriter file_;
   PosWriterOptions options_;
 };
 
