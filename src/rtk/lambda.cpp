@@ -414,7 +414,17 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
     out.squared_norms(j) = found->squared_norms(from);
   }
   out.Z = std::move(dec.Z);
+  out.conditional_variances = std::move(dec.d);
   return out;
+}
+
+double bootstrap_success_rate(const Eigen::VectorXd& conditional_variances) {
+  double p = 1.0;
+  for (const double d : conditional_variances) {
+    if (!(d > 0.0)) return 0.0;
+    p *= std::erf(1.0 / (2.0 * std::sqrt(2.0 * d)));
+  }
+  return p;
 }
 
 RatioTestOutcome ratio_test(const IntegerSearchResult& result, double threshold) {

@@ -673,3 +673,77 @@ TEST(FixedSolutionTest, RejectsBadInput) {
 
 }  // namespace
 }  // namespace canyon::rtk
+
+namespace canyon::rtk {
+namespace {
+
+// Integer bootstrapping success rate, computed here from Phi (erfc) rather than erf: 2 Phi(1 / (2 sigma)) - 1.
+double bootstrap_reference(const Eigen::VectorXd& variances) {
+  double p = 1.0;
+  for (const double d : variances) p *= 2.0 * (0.5 * std::erfc(-1.0 / (2.0 * std::sqrt(d)) / std::sqrt(2.0))) - 1.0;
+  return p;
+}
+
+TEST(SuccessRateTest, DiagonalCovarianceGivesTheProductOfIndependentRoundings) {
+  const Eigen::Vector3d variances(0.01, 0.04, 0.09);  // sigma 0.1, 0.2, 0.3 cycles
+  const auto result = mlambda(Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Matrix3d(variances.asDiagonal()));
+  ASSERT_TRUE(result) << result.error().message;
+  EXPECT_NEAR(bootstrap_success_rate(result->conditional_variances), bootstrap_reference(variances), 1e-12);
+  // sigma 0.3 cycles alone: 2 Phi(1.667) - 1 = 0.9044.
+  EXPECT_NEAR(bootstrap_success_rate(Eigen::VectorXd::Constant(1, 0.09)), 0.90442, 1e-5);
+}
+
+TEST(SuccessRateTest, ConditionalVariancesMultiplyToTheDeterminant) {
+  // Z is unimodular, so det(Q_z) = det(Q_a) = prod d_k: the reported conditional variances are those of Q_a.
+  std::mt19937_64 rng(7);
+  for (const int n : {4, 10, 24}) {
+    const Eigen::MatrixXd Q_a = testing::gnss_like_covariance(n, rng);
+    const auto result = mlambda(Eigen::VectorXd::Zero(n), Q_a);
+    ASSERT_TRUE(result) << result.error().message;
+    ASSERT_EQ(result->conditional_variances.size(), n);
+    const double log_det = Q_a.llt().matrixLLT().diagonal().array().log().sum() * 2.0;
+    EXPECT_NEAR(result->conditional_variances.array().log().sum(), log_det, 1e-8 * std::abs(log_det)) << n;
+  }
+}
+
+TEST(SuccessRateTest, BoundsTheIntegerLeastSquaresSuccessRateFromBelow) {
+  // Teunissen (1999): P(ILS correct) >= bootstrapped success rate. Monte Carlo on a GNSS-like covariance scaled so
+  // that the bound is about 0.8: the observed ILS success fraction must not fall below it (3 binomial sigmas).
+  std::mt19937_64 rng(11);
+  const int n = 8;
+  Eigen::MatrixXd Q_a = testing::gnss_like_covariance(n, rng);
+  double rate = 0.0;
+  for (int i = 0; i < 60 && !(rate > 0.75 && rate < 0.85); ++i) {
+    const auto r = mlambda(Eigen::VectorXd::Zero(n), Q_a);
+    ASSERT_TRUE(r);
+    rate = bootstrap_success_rate(r->conditional_variances);
+    Q_a *= rate > 0.85 ? 1.3 : 0.8;
+  }
+  const auto r = mlambda(Eigen::VectorXd::Zero(n), Q_a);
+  ASSERT_TRUE(r);
+  rate = bootstrap_success_rate(r->conditional_variances);
+  ASSERT_GT(rate, 0.6);
+  ASSERT_LT(rate, 0.95);
+  const Eigen::LLT<Eigen::MatrixXd> llt(Q_a);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const int trials = 4000;
+  int correct = 0;
+  for (int t = 0; t < trials; ++t) {
+    Eigen::VectorXd white(n);
+    for (Eigen::Index i = 0; i < n; ++i) white(i) = normal(rng);
+    const auto fix = mlambda(llt.matrixL() * white, Q_a);  // the true ambiguities are 0
+    ASSERT_TRUE(fix);
+    if (fix->candidates.col(0).isZero()) ++correct;
+  }
+  const double observed = static_cast<double>(correct) / trials;
+  EXPECT_GE(observed, rate - 3.0 * std::sqrt(rate * (1.0 - rate) / trials)) << "bound " << rate;
+}
+
+TEST(SuccessRateTest, DegenerateInput) {
+  EXPECT_EQ(bootstrap_success_rate(Eigen::VectorXd()), 1.0);
+  EXPECT_EQ(bootstrap_success_rate(Eigen::Vector2d(0.01, 0.0)), 0.0);
+  EXPECT_EQ(bootstrap_success_rate(Eigen::Vector2d(0.01, std::nan(""))), 0.0);
+}
+
+}  // namespace
+}  // namespace canyon::rtk

@@ -62,10 +62,11 @@ struct MlambdaOptions {
 
 /// Output of mlambda().
 struct IntegerSearchResult {
-  Eigen::MatrixXd candidates;     ///< n x m, column j = j-th best integer vector in the a-space (integers)
-  Eigen::VectorXd squared_norms;  ///< m, ascending: (a_float - a_j)^T Q_a^{-1} (a_float - a_j)
-  Eigen::MatrixXd Z;              ///< n x n unimodular decorrelation, z = Z^T a, Q_z = Z^T Q_a Z
-  std::int64_t search_nodes = 0;  ///< search steps used (for diagnostics and benchmarks)
+  Eigen::MatrixXd candidates;             ///< n x m, column j = j-th best integer vector in the a-space (integers)
+  Eigen::VectorXd squared_norms;          ///< m, ascending: (a_float - a_j)^T Q_a^{-1} (a_float - a_j)
+  Eigen::MatrixXd Z;                      ///< n x n unimodular decorrelation, z = Z^T a, Q_z = Z^T Q_a Z
+  Eigen::VectorXd conditional_variances;  ///< d of Q_z = L^T diag(d) L after the reduction [cycles^2]
+  std::int64_t search_nodes = 0;          ///< search steps used (for diagnostics and benchmarks)
 };
 
 /// The decorrelated problem: Z^T Q_a Z = L^T diag(d) L.
@@ -94,6 +95,13 @@ inline constexpr double kDefaultRatioThreshold = 3.0;
 
 /// Ratio test second-best / best squared norm. Needs >= 2 candidates (asserted; returns not passed otherwise).
 [[nodiscard]] RatioTestOutcome ratio_test(const IntegerSearchResult& result, double threshold = kDefaultRatioThreshold);
+
+/// Success rate of integer bootstrapping on the decorrelated ambiguities, a sharp lower bound of the success rate of
+/// integer least squares (Teunissen 1999, "An optimality property of the integer least-squares estimator",
+/// J. Geodesy 73:587-593):  P_s = prod_k (2 Phi(1 / (2 sqrt(d_k))) - 1) = prod_k erf(1 / (2 sqrt(2 d_k))).
+/// It depends only on the model (the float covariance), not on the data: the probability that the fix is right if
+/// the float solution is unbiased. 1 for an empty d; 0 if some d_k is not positive.
+[[nodiscard]] double bootstrap_success_rate(const Eigen::VectorXd& conditional_variances);
 
 /// Contribution of each ambiguity to the integer least-squares residual of a fixed vector a_fix:
 ///   c_i = r(a) - r_{-i}(a),  r(a) = e^T Q_a^{-1} e,  e = a_float - a_fix,
