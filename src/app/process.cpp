@@ -16,7 +16,7 @@
 namespace canyon::app {
 namespace {
 
-constexpr std::size_t kMaxUnsolvedReasons = 100;
+constexpr std::size_t kMaxEpochNotes = 100;
 
 Result<core::NavigationData> read_navigation(const std::vector<std::string>& paths,
                                              std::vector<std::string>& warnings) {
@@ -85,11 +85,25 @@ struct Outputs {
   }
 };
 
-void add_unsolved(ProcessSummary& summary, const core::GpsTime& t, const std::string& reason) {
-  if (summary.unsolved_reasons.size() >= kMaxUnsolvedReasons) return;
+/// Notes why an epoch got no solution ("no solution: ...") or a solution below the mode's best ("float: ...").
+void add_epoch_note(ProcessSummary& summary, const core::GpsTime& t, const char* outcome, const std::string& reason) {
+  if (summary.epoch_notes.size() >= kMaxEpochNotes) return;
   char when[48];
   std::snprintf(when, sizeof when, "%d %.3f: ", t.week, t.tow_s);
-  summary.unsolved_reasons.push_back(when + reason);
+  std::string note = when;
+  note += outcome;
+  note += ": ";
+  note += reason;
+  summary.epoch_notes.push_back(std::move(note));
+}
+
+const char* status_word(core::SolutionStatus status) {
+  switch (status) {
+    case core::SolutionStatus::Fixed: return "fixed";
+    case core::SolutionStatus::Float: return "float";
+    case core::SolutionStatus::Single: return "single";
+    default: return "other";
+  }
 }
 
 Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
@@ -105,7 +119,7 @@ Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
       if (Status w = writer.write(to_solution(*sol), sol->dop.hdop); !w) return w.error();
       ++summary.solved;
     } else {
-      add_unsolved(summary, epoch.time, sol.error().message);
+      add_epoch_note(summary, epoch.time, "no solution", sol.error().message);
     }
     if (progress) progress(summary.epochs, total);
   }
@@ -126,9 +140,11 @@ Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
       if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
       ++summary.solved;
       if (result->solution.status == core::SolutionStatus::Fixed) ++summary.fixed;
-      if (result->solution.status != core::SolutionStatus::Fixed) add_unsolved(summary, epoch.time, result->note);
+      if (result->solution.status != core::SolutionStatus::Fixed) {
+        add_epoch_note(summary, epoch.time, status_word(result->solution.status), result->note);
+      }
     } else {
-      add_unsolved(summary, epoch.time, result.error().message);
+      add_epoch_note(summary, epoch.time, "no solution", result.error().message);
     }
     if (progress) progress(summary.epochs, total);
   }

@@ -78,7 +78,7 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
       ->check(CLI::Range(0.0, 89.9));
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
-  cmd->add_flag("-v,--verbose", args.verbose, "Log why each unsolved epoch got no solution (first 100)");
+  cmd->add_flag("-v,--verbose", args.verbose, "Log why epochs got no solution or, in rtk mode, no fix (first 100)");
 }
 
 int run_process_command(const ProcessArgs& args) {
@@ -159,8 +159,7 @@ int run_process_command(const ProcessArgs& args) {
                  summary->warnings.size() - kMaxWarningsShown);
   }
   if (args.verbose) {
-    for (const std::string& r : summary->unsolved_reasons)
-      std::fprintf(stderr, "canyon: no solution at %s\n", r.c_str());
+    for (const std::string& note : summary->epoch_notes) std::fprintf(stderr, "canyon: %s\n", note.c_str());
   }
   if (!args.quiet) {
     const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;

@@ -176,9 +176,9 @@ TEST(SppProcess, EpochsWithTooFewSatellitesAreSkippedAndProcessingGoesOn) {
   ASSERT_TRUE(summary.ok()) << summary.error().to_string();
   EXPECT_EQ(summary->epochs, 120);
   EXPECT_LT(summary->solved, 120);
-  EXPECT_FALSE(summary->unsolved_reasons.empty());
-  EXPECT_NE(summary->unsolved_reasons.front().find("too few satellites"), std::string::npos)
-      << summary->unsolved_reasons.front();
+  ASSERT_FALSE(summary->epoch_notes.empty());
+  EXPECT_NE(summary->epoch_notes.front().find("no solution: too few satellites"), std::string::npos)
+      << summary->epoch_notes.front();
 }
 
 }  // namespace

@@ -11,12 +11,14 @@
 namespace canyon::app {
 
 struct ProcessSummary {
-  int epochs = 0;                             ///< rover epochs read
-  int solved = 0;                             ///< epochs with a solution written
-  int fixed = 0;                              ///< epochs with a fixed (RTK) solution
-  double wall_s = 0.0;                        ///< wall-clock time of the whole run
-  std::vector<std::string> warnings;          ///< recovered input defects, "file:line: what"
-  std::vector<std::string> unsolved_reasons;  ///< one line per unsolved epoch, "week tow: reason" (first 100)
+  int epochs = 0;                     ///< rover epochs read
+  int solved = 0;                     ///< epochs with a solution written
+  int fixed = 0;                      ///< epochs with a fixed (RTK) solution
+  double wall_s = 0.0;                ///< wall-clock time of the whole run
+  std::vector<std::string> warnings;  ///< recovered input defects, "file:line: what"
+  /// Why epochs got no solution or one below the mode's best (first 100): "week tow: no solution: reason" or, in
+  /// rtk mode, "week tow: float: ratio test failed" (status, then why it is not fixed).
+  std::vector<std::string> epoch_notes;
 };
 
 /// Called after each epoch with (epochs done, epochs in total).
