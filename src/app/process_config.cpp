@@ -72,6 +72,9 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("min_fix_ambiguities", o.min_fix_ambiguities);
   map.get("min_lock_epochs", o.min_lock_epochs);
   map.get("partial_ar", o.partial_ar);
+  map.get("max_pruned_satellites", o.max_pruned_satellites);
+  map.get("min_success_rate", o.min_success_rate);
+  map.get("min_partial_fraction", o.min_partial_fraction);
   std::string glonass_ar = o.glonass_ar ? "on" : "off";
   map.get("glonass_ar", glonass_ar);
   if (glonass_ar != "on" && glonass_ar != "off" && glonass_ar != "true" && glonass_ar != "false") {
@@ -243,6 +246,9 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "min_fix_ambiguities" << YAML::Value << o.min_fix_ambiguities;
   out << YAML::Key << "min_lock_epochs" << YAML::Value << o.min_lock_epochs;
   out << YAML::Key << "partial_ar" << YAML::Value << o.partial_ar;
+  out << YAML::Key << "max_pruned_satellites" << YAML::Value << o.max_pruned_satellites;
+  out << YAML::Key << "min_success_rate" << YAML::Value << o.min_success_rate;
+  out << YAML::Key << "min_partial_fraction" << YAML::Value << o.min_partial_fraction;
   out << YAML::Key << "glonass_ar" << YAML::Value << (o.glonass_ar ? "on" : "off");
   out << YAML::Key << "dynamics" << YAML::Value << o.dynamics;
   out << YAML::Key << "accel_sigma_h_mps2" << YAML::Value << o.accel_sigma_h_mps2;
@@ -272,6 +278,7 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
 
 std::string to_yaml(const ProcessConfig& c) {
   YAML::Emitter out;
+  out.SetDoublePrecision(12);  // shortest form of the configured values (0.99, not 0.98999999999999999)
   out << YAML::BeginMap;
   out << YAML::Key << "mode" << YAML::Value << mode_name(c.mode);
   out << YAML::Key << "rover" << YAML::Value << c.rover_obs;

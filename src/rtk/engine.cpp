@@ -19,7 +19,9 @@ namespace {
 using core::Constellation;
 using core::SatelliteId;
 
-constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
+constexpr double kMaxBaseTimeAheadS = 0.05;
+constexpr std::size_t kPrunedSubsets = 3;  // partial fixing prunes at most this many group-excluded subsets  // base
+                                           // tags up to this much after the rover tag still count as "now"
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {
@@ -135,6 +137,9 @@ std::string RtkOptions::validate() const {
   }
   if (!(ratio_threshold >= 1.0)) return "ratio_threshold must be >= 1";
   if (min_fix_ambiguities < 1) return "min_fix_ambiguities must be >= 1";
+  if (!(min_success_rate >= 0.0 && min_success_rate <= 1.0)) return "min_success_rate must be in [0, 1]";
+  if (!(min_partial_fraction >= 0.0 && min_partial_fraction <= 1.0)) return "min_partial_fraction must be in [0, 1]";
+  if (max_pruned_satellites < 0) return "max_pruned_satellites must be >= 0";
   if (!(phase_sigma_m > 0.0) || !(code_phase_ratio > 0.0)) return "phase_sigma_m and code_phase_ratio must be > 0";
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
@@ -185,6 +190,9 @@ void RtkEngine::remove_ambiguity(const AmbiguityKey& key) {
   P_.conservativeResize(n - 1, n - 1);
   ambiguity_keys_.erase(ambiguity_keys_.begin() + (index - num_kinematic_states()));
   ambiguity_info_.erase(key);
+  for (auto it = last_fix_.begin(); it != last_fix_.end();) {
+    it = (it->first.first == key || it->first.second == key) ? last_fix_.erase(it) : std::next(it);
+  }
 }
 
 void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp) {
@@ -414,13 +422,22 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
 
 namespace {
 
-/// DD ambiguities (state index of s, state index of its group's reference) of the fixable SDs of the groups not
-/// excluded; the reference of each group is its highest fixable satellite.
-std::vector<std::pair<int, int>> dd_ambiguities(const std::vector<SingleDiff>& sds, int excluded_group) {
+/// Which fixable SDs a DD ambiguity set leaves out: one (constellation, frequency) group, or a whole constellation.
+struct Exclusion {
+  int group = -1;
+  int constellation = -1;
+  [[nodiscard]] bool excludes(const SingleDiff& sd) const {
+    return sd.group == group || sd.group / kMaxFrequencies == constellation;
+  }
+};
+
+/// DD ambiguities (state index of s, state index of its group's reference) of the fixable SDs not excluded; the
+/// reference of each group is its highest fixable satellite.
+std::vector<std::pair<int, int>> dd_ambiguities(const std::vector<SingleDiff>& sds, const Exclusion& excluded) {
   std::map<int, int> reference;  // group -> SD index
   for (int i = 0; i < static_cast<int>(sds.size()); ++i) {
     const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
-    if (!sd.fixable || sd.ambiguity < 0 || sd.group == excluded_group) continue;
+    if (!sd.fixable || sd.ambiguity < 0 || excluded.excludes(sd)) continue;
     auto it = reference.find(sd.group);
     if (it == reference.end() || sd.elevation_rad > sds[static_cast<std::size_t>(it->second)].elevation_rad) {
       reference[sd.group] = i;
@@ -429,19 +446,44 @@ std::vector<std::pair<int, int>> dd_ambiguities(const std::vector<SingleDiff>& s
   std::vector<std::pair<int, int>> dd;
   for (int i = 0; i < static_cast<int>(sds.size()); ++i) {
     const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
-    if (!sd.fixable || sd.ambiguity < 0 || sd.group == excluded_group) continue;
+    if (!sd.fixable || sd.ambiguity < 0 || excluded.excludes(sd)) continue;
     const int r = reference.at(sd.group);
     if (r != i) dd.emplace_back(sd.ambiguity, sds[static_cast<std::size_t>(r)].ambiguity);
   }
   return dd;
 }
 
+/// The exclusions partial fixing tries after pruning: each (constellation, frequency) group, then each
+/// constellation that has more than one group (dual-frequency signals that two receivers track differently, or a
+/// constellation whose ambiguities are biased as a whole).
+std::vector<Exclusion> partial_exclusions(const std::vector<SingleDiff>& sds) {
+  std::map<int, int> groups_per_constellation;
+  std::map<int, bool> groups;
+  for (const SingleDiff& sd : sds) {
+    if (!sd.fixable || sd.ambiguity < 0 || groups.count(sd.group) != 0) continue;
+    groups[sd.group] = true;
+    ++groups_per_constellation[sd.group / kMaxFrequencies];
+  }
+  std::vector<Exclusion> out;
+  for (const auto& [group, unused] : groups) {
+    (void)unused;
+    out.push_back(Exclusion{group, -1});
+  }
+  if (groups_per_constellation.size() > 1) {
+    for (const auto& [constellation, count] : groups_per_constellation) {
+      if (count > 1) out.push_back(Exclusion{-1, constellation});
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
-std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int, int>>& dd) const {
+std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int, int>>& dd, int min_size) const {
   const auto nd = static_cast<Eigen::Index>(dd.size());
-  if (nd < options_.min_fix_ambiguities) return std::nullopt;
+  if (nd < std::max(min_size, options_.min_fix_ambiguities)) return std::nullopt;
   Fix fix;
+  fix.dd = dd;
   // D has +1 and -1 per row: D x, P D^T and D P D^T from columns of P, without dense products.
   fix.a_float.resize(nd);
   fix.PDt.resize(x_.size(), nd);
@@ -460,43 +502,121 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
   if (!search) return std::nullopt;
   fix.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
   fix.squared_norm = search->squared_norms[0];
+  fix.success_rate = bootstrap_success_rate(search->conditional_variances);
   fix.a_fix = search->candidates.col(0);
   return fix;
 }
 
+bool RtkEngine::agrees_with_last_fix(const Fix& fix) const {
+  for (std::size_t k = 0; k < fix.dd.size(); ++k) {
+    const auto it = last_fix_.find(dd_key(fix.dd[k]));
+    if (it != last_fix_.end() && it->second != fix.a_fix[static_cast<Eigen::Index>(k)]) return false;
+  }
+  return true;
+}
+
+RtkEngine::DdKey RtkEngine::dd_key(const std::pair<int, int>& dd) const {
+  const auto k = static_cast<std::size_t>(num_kinematic_states());
+  return {ambiguity_keys_[static_cast<std::size_t>(dd.first) - k],
+          ambiguity_keys_[static_cast<std::size_t>(dd.second) - k]};
+}
+
+bool RtkEngine::accepted(const Fix& fix) const {
+  if (!agrees_with_last_fix(fix)) return false;
+  return fix.ratio >= options_.ratio_threshold && fix.success_rate >= options_.min_success_rate;
+}
+
+SatelliteId RtkEngine::satellite_of_state(int index) const {
+  return ambiguity_keys_[static_cast<std::size_t>(index - num_kinematic_states())].first;
+}
+
+SatelliteId RtkEngine::satellite_of_largest_contribution(const std::vector<std::pair<int, int>>& dd,
+                                                         const Eigen::VectorXd& contributions) const {
+  std::map<SatelliteId, double> per_satellite;
+  for (std::size_t k = 0; k < dd.size(); ++k) {
+    per_satellite[satellite_of_state(dd[k].first)] += contributions[static_cast<Eigen::Index>(k)];
+  }
+  const auto worst = std::max_element(per_satellite.begin(), per_satellite.end(),
+                                      [](const auto& l, const auto& r) { return l.second < r.second; });
+  return worst->first;
+}
+
+std::optional<RtkEngine::Fix> RtkEngine::prune(Fix fix, int min_size) const {
+  // The paper's pruning: drop the satellite whose DD ambiguities contribute most to the integer least-squares
+  // residual of the best candidate (the sum of their squared w-test statistics) and solve again, until a fix is
+  // accepted. Satellite by satellite, because what biases an ambiguity (multipath, reflection, a low elevation)
+  // biases all frequencies of that satellite.
+  for (int pruned = 0; pruned < options_.max_pruned_satellites; ++pruned) {
+    const auto contributions = ils_residual_contributions(fix.a_float, fix.Q_a, fix.a_fix);
+    if (!contributions) return std::nullopt;
+    const SatelliteId worst = satellite_of_largest_contribution(fix.dd, *contributions);
+    std::vector<std::pair<int, int>> dd = fix.dd;
+    dd.erase(std::remove_if(dd.begin(), dd.end(),
+                            [&](const std::pair<int, int>& p) { return satellite_of_state(p.first) == worst; }),
+             dd.end());
+    auto next = try_fix(dd, min_size);
+    if (!next) return std::nullopt;
+    if (accepted(*next)) return next;
+    fix = std::move(*next);
+  }
+  return std::nullopt;
+}
+
+bool RtkEngine::better_fix(const Fix& l, const Fix& r) {
+  return l.a_fix.size() > r.a_fix.size() || (l.a_fix.size() == r.a_fix.size() && l.ratio > r.ratio);
+}
+
+std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
+                                                     int min_size) const {
+  // First prune satellites from the full set. Then leave out whole groups or constellations (signals that the two
+  // receivers track differently bias a whole group): the accepted subset with the most ambiguities, or else the
+  // best of pruning the kPrunedSubsets subsets closest to passing (highest ratio). At most
+  // 1 + (1 + kPrunedSubsets) max_pruned_satellites + (number of exclusions) integer searches per epoch.
+  if (full) {
+    if (auto pruned = prune(std::move(*full), min_size)) return pruned;
+  }
+  std::optional<Fix> best_accepted;
+  std::vector<Fix> rejected;
+  for (const Exclusion& exclusion : partial_exclusions(sds)) {
+    auto candidate = try_fix(dd_ambiguities(sds, exclusion), min_size);
+    if (!candidate) continue;
+    if (!accepted(*candidate)) {
+      rejected.push_back(std::move(*candidate));
+    } else if (!best_accepted || better_fix(*candidate, *best_accepted)) {
+      best_accepted = std::move(candidate);
+    }
+  }
+  if (best_accepted) return best_accepted;
+  // Prune the subsets closest to passing (highest ratio first).
+  std::sort(rejected.begin(), rejected.end(), [](const Fix& l, const Fix& r) { return l.ratio > r.ratio; });
+  if (rejected.size() > kPrunedSubsets) rejected.resize(kPrunedSubsets);
+  for (Fix& candidate : rejected) {
+    auto pruned = prune(std::move(candidate), min_size);
+    if (pruned && (!best_accepted || better_fix(*pruned, *best_accepted))) best_accepted = std::move(pruned);
+  }
+  return best_accepted;
+}
+
 bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out) {
-  const auto all = dd_ambiguities(sds, -1);
+  const auto all = dd_ambiguities(sds, Exclusion{});
   if (static_cast<int>(all.size()) < options_.min_fix_ambiguities) {
     out.note = "too few ambiguities to fix: " + std::to_string(all.size());
     return false;
   }
-  std::optional<Fix> best = try_fix(all);
+  std::optional<Fix> best = try_fix(all, options_.min_fix_ambiguities);
   if (best) out.solution.ratio = std::min(best->ratio, 999.9);
-  if ((!best || best->ratio < options_.ratio_threshold) && !options_.partial_ar) {
-    out.note = "ratio test failed";
-    return false;
-  }
-  if (!best || best->ratio < options_.ratio_threshold) {
-    // Partial fixing: one (constellation, frequency) group whose ambiguities are not integers (e.g. signals that two
-    // receivers track differently) must not spoil the others: retry without each group, keep the best that passes.
-    std::map<int, bool> groups;
-    for (const SingleDiff& sd : sds) {
-      if (sd.fixable && sd.ambiguity >= 0) groups[sd.group] = true;
-    }
-    std::optional<Fix> partial;
-    for (const auto& [group, unused] : groups) {
-      (void)unused;
-      auto candidate = try_fix(dd_ambiguities(sds, group));
-      if (candidate && candidate->ratio >= options_.ratio_threshold &&
-          (!partial || candidate->ratio > partial->ratio)) {
-        partial = std::move(candidate);
-      }
-    }
-    if (!partial) {
-      out.note = "ratio test failed";
+  if (!best || !accepted(*best)) {
+    const std::string why = !best                                    ? "integer search failed"
+                            : best->ratio < options_.ratio_threshold ? "ratio test failed"
+                                                                     : "success rate too low";
+    // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the
+    // float ambiguities left out, which are biased when the full set fails.
+    const auto min_size = static_cast<int>(std::ceil(options_.min_partial_fraction * static_cast<double>(all.size())));
+    best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
+    if (!best) {
+      out.note = why;
       return false;
     }
-    best = std::move(partial);
     out.solution.ratio = std::min(best->ratio, 999.9);
   }
   // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix).
@@ -511,6 +631,9 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   out.solution.P_E_m2 = P_fix.topLeftCorner<3, 3>();
   out.solution.status = core::SolutionStatus::Fixed;
   out.num_fixed_ambiguities = static_cast<int>(best->a_fix.size());
+  last_fix_.clear();
+  for (std::size_t k = 0; k < best->dd.size(); ++k)
+    last_fix_[dd_key(best->dd[k])] = best->a_fix[static_cast<Eigen::Index>(k)];
   if (options_.ar_mode == ArMode::FixAndHold) {
     // Hold: the fixed DD ambiguities as pseudo-measurements with a small variance, into the float filter.
     const double var = options_.hold_sigma_cyc * options_.hold_sigma_cyc;

@@ -32,12 +32,16 @@
 // single-point solution with a large variance; with dynamics a constant-acceleration model with white jerk.
 // Ambiguities carry over with a small random walk.
 //
-// Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA, ratio test; the fixed position
-// from the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix). Modes: continuous, instantaneous (ambiguities
-// re-initialised every epoch), fix-and-hold (the fixed DD ambiguities fed back as pseudo-measurements with a small
-// variance). When the whole set fails the ratio test, partial fixing tries it without each (constellation, frequency)
-// group in turn and keeps the passing fix with the highest ratio. GLONASS ambiguities are fixed only when glonass_ar
-// is on.
+// Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA; a fix is accepted when it passes
+// the ratio test, the bootstrapped success rate of the float covariance reaches min_success_rate (the ratio test
+// alone accepts wrong single-frequency, single-epoch fixes), and no DD ambiguity also fixed at the last fix (no slip
+// since) gets another integer. The fixed position from the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix).
+// Modes: continuous, instantaneous (ambiguities re-initialised every epoch), fix-and-hold (the fixed DD ambiguities
+// fed back as pseudo-measurements with a small variance). When the whole set is not accepted, partial fixing
+// (partial_ar): the paper's pruning, dropping the satellite whose ambiguities contribute most to the integer
+// least-squares residual, one at a time; then leaving out each (constellation, frequency) group and each
+// constellation; a subset keeps at least min_partial_fraction of the ambiguities. GLONASS ambiguities are fixed only
+// when glonass_ar is on.
 
 #include <map>
 #include <optional>
@@ -81,7 +85,10 @@ struct RtkOptions {
   double initial_position_sigma_m = 30.0;     ///< sigma of the SPP position used as prior (m)
   double ratio_threshold = 3.0;               ///< ratio test threshold (the paper's 3.0)
   int min_fix_ambiguities = 4;                ///< fewer DD ambiguities are not fixed
-  bool partial_ar = true;                     ///< when the full set fails, fix without one (system, frequency) group
+  bool partial_ar = true;                     ///< when the full set fails, fix a subset (pruning, groups)
+  int max_pruned_satellites = 6;              ///< partial fixing drops at most this many satellites one by one
+  double min_success_rate = 0.99;             ///< bootstrapped success rate a fix needs besides the ratio test
+  double min_partial_fraction = 0.2;          ///< a partial fix keeps at least this fraction of the ambiguities
   int min_lock_epochs = 0;                    ///< epochs an ambiguity must be tracked before it is fixed
   bool glonass_ar = false;                    ///< fix GLONASS ambiguities (needs equal inter-frequency biases)
   double max_age_s = 30.0;                    ///< base observations older than this are not used
@@ -145,15 +152,36 @@ class RtkEngine {
   int update_once(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected, PostFit& post_fit);
   /// A candidate fix of a set of DD ambiguities (state index of s, of its reference).
   struct Fix {
-    Eigen::MatrixXd D;  // DD ambiguities = D x
+    std::vector<std::pair<int, int>> dd;  // DD ambiguities: (state index of s, of its reference)
     Eigen::VectorXd a_float;
     Eigen::MatrixXd Q_a;    // D P D^T
     Eigen::MatrixXd PDt;    // P D^T
     Eigen::VectorXd a_fix;  // best integer candidate
     double ratio = 0.0;
     double squared_norm = 0.0;  // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
+    double success_rate = 0.0;  // bootstrapped success rate of the float model
   };
-  [[nodiscard]] std::optional<Fix> try_fix(const std::vector<std::pair<int, int>>& dd) const;
+  /// MLAMBDA on a set of DD ambiguities; nullopt if the set has fewer than max(min_size, min_fix_ambiguities).
+  [[nodiscard]] std::optional<Fix> try_fix(const std::vector<std::pair<int, int>>& dd, int min_size) const;
+  /// Ratio test, success rate and agreement with the last fix.
+  [[nodiscard]] bool accepted(const Fix& fix) const;
+  /// A DD ambiguity by the keys of its two SD ambiguities (satellite s, reference satellite).
+  using DdKey = std::pair<AmbiguityKey, AmbiguityKey>;
+  [[nodiscard]] DdKey dd_key(const std::pair<int, int>& dd) const;
+  /// False if a DD ambiguity also fixed at the last fix (no slip since) gets another integer: a fix that contradicts
+  /// its predecessor is a wrong fix of one of them, and is not taken.
+  [[nodiscard]] bool agrees_with_last_fix(const Fix& fix) const;
+  /// Drops the satellite with the largest integer least-squares residual contribution until a fix is accepted (at
+  /// most max_pruned_satellites); nullopt if none is.
+  [[nodiscard]] std::optional<Fix> prune(Fix fix, int min_size) const;
+  [[nodiscard]] core::SatelliteId satellite_of_state(int index) const;
+  [[nodiscard]] core::SatelliteId satellite_of_largest_contribution(const std::vector<std::pair<int, int>>& dd,
+                                                                    const Eigen::VectorXd& contributions) const;
+  /// More ambiguities, then the higher ratio.
+  [[nodiscard]] static bool better_fix(const Fix& l, const Fix& r);
+  /// Partial fixing after the full set failed: pruning, then without each group or constellation.
+  [[nodiscard]] std::optional<Fix> partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
+                                               int min_size) const;
   /// MLAMBDA and the ratio test, then partial fixing without one group if the whole set fails; fills the fixed
   /// solution of `out` and returns true when fixed.
   bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
@@ -175,6 +203,7 @@ class RtkEngine {
   CycleSlipDetector rover_slips_;
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;
+  std::map<DdKey, double> last_fix_;  // integers of the last accepted fix; pairs leave with their ambiguities
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);
