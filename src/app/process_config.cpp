@@ -110,6 +110,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   if (iono != "estimate" && iono != "off") map.fail("ionosphere", "must be off or estimate, not '" + iono + "'");
   o.ionosphere = iono == "estimate" ? rtk::IonosphereModel::Estimate : rtk::IonosphereModel::Off;
   map.get("iono_sigma_per_10km_m", o.iono_sigma_per_10km_m);
+  map.get("iono_sigma_min_m", o.iono_sigma_min_m);
   map.get("iono_noise_m", o.iono_noise_m);
   map.reject_unknown_keys();
 }
@@ -272,6 +273,7 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "ionosphere" << YAML::Value
       << (o.ionosphere == rtk::IonosphereModel::Estimate ? "estimate" : "off");
   out << YAML::Key << "iono_sigma_per_10km_m" << YAML::Value << o.iono_sigma_per_10km_m;
+  out << YAML::Key << "iono_sigma_min_m" << YAML::Value << o.iono_sigma_min_m;
   out << YAML::Key << "iono_noise_m" << YAML::Value << o.iono_noise_m;
   out << YAML::EndMap;
 }

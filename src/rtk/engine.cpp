@@ -276,7 +276,7 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
   }
   if (options_.ionosphere == IonosphereModel::Estimate) {
     const double baseline_10km = (x_.head<3>() - p_E_base_m_).norm() / 1e4;
-    const double sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, 0.001);
+    const double sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m);
     for (const SingleDiff& sd : sds) {
       const AmbiguityKey key{sd.sat, kIonoKey};
       if (ambiguity_index(key) < 0) add_ambiguity(key, 0.0, sigma_m * sigma_m);

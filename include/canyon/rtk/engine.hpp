@@ -102,6 +102,7 @@ struct RtkOptions {
   bool troposphere_saastamoinen = true;       ///< model the troposphere at each receiver (off: data without one)
   IonosphereModel ionosphere = IonosphereModel::Off;  ///< differential ionosphere model
   double iono_sigma_per_10km_m = 0.03;  ///< prior sigma of a SD ionosphere state per 10 km of baseline (m)
+  double iono_sigma_min_m = 0.001;      ///< the prior sigma is at least this (m), whatever the baseline
   double iono_noise_m = 0.001;          ///< SD ionosphere random walk (m per sqrt(s))
   gnss::SppOptions spp;                 ///< single-point solution (prior and fallback)
 
