@@ -33,6 +33,23 @@ Result<core::NavigationData> read_navigation(const std::vector<std::string>& pat
   return nav;
 }
 
+/// GLONASS ambiguities are integers only if the receivers' inter-frequency phase biases cancel, i.e. for receivers of
+/// one type: a warning when GLONASS AR is on and the RINEX headers name different receiver types.
+std::string glonass_ar_warning(const ProcessConfig& config, const io::RinexObsHeader& rover,
+                               const io::RinexObsHeader& base) {
+  if (!config.rtk.glonass_ar || !config.rtk.observables.use_glonass) return {};
+  const std::string& r = rover.receiver.receiver_type;
+  const std::string& b = base.receiver.receiver_type;
+  if (r == b) return {};
+  std::string w = "glonass_ar is on but the rover receiver '";
+  w += r;
+  w += "' and the base receiver '";
+  w += b;
+  w += "' differ: their GLONASS inter-frequency phase biases need not cancel and GLONASS fixes may be wrong "
+       "(set glonass_ar: off)";
+  return w;
+}
+
 std::vector<std::string> header_lines(const ProcessConfig& config) {
   std::vector<std::string> lines;
   lines.push_back("program   : canyon process (mode " + mode_name(config.mode) + ")");
@@ -186,6 +203,9 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
         std::abs(rover->epochs.front().time - base_file->epochs.front().time) > 86400.0 &&
         std::abs(rover->epochs.back().time - base_file->epochs.back().time) > 86400.0) {
       summary.warnings.push_back(config.base_obs + ": base observations do not overlap the rover's (another day?)");
+    }
+    if (std::string w = glonass_ar_warning(config, rover->header, base_file->header); !w.empty()) {
+      summary.warnings.push_back(std::move(w));
     }
     base = std::move(*base_file);
   }
