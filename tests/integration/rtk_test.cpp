@@ -425,3 +425,63 @@ TEST(RtkIonosphere, EstimatedIonosphereHandlesA20KmDifferentialDelay) {
 
 }  // namespace
 }  // namespace canyon
+
+namespace canyon {
+namespace {
+
+/// Epoch matching on the simulator's data (exact truth): a rover whose clock runs 5 ms behind the base's (time
+/// tags 5 ms earlier, pseudoranges c * 5 ms shorter, phases f * 5 ms cycles fewer, as a receiver clock bias makes
+/// them), and a base at a fifth of the rover's rate (every 5th epoch kept, so observations up to 4 s old are used).
+TEST(RtkEpochMatching, FiveMillisecondClockOffsetAndLowerRateBase) {
+  REQUIRE_DATA("instinct-spirent-rtk-sim");
+  const std::string dir = "instinct-spirent-rtk-sim/iono-none_tropo-none/";
+  const fs::path tmp = test::temp_dir("rtk-matching");
+  auto rover = io::read_rinex_obs((shared_data() / dir / "Rover-static-2km-east_MO_Spirent.obs").string());
+  auto base = io::read_rinex_obs((shared_data() / dir / "Base-static_MO_Spirent.obs").string());
+  ASSERT_TRUE(rover.ok() && base.ok());
+  constexpr double kOffsetS = -0.005;  // the rover tags come 5 ms before the base tags of the same instant
+  for (core::ObsEpoch& epoch : rover->epochs) {
+    epoch.time = epoch.time + kOffsetS;
+    for (core::SatelliteObs& sat : epoch.sats) {
+      for (core::SignalObs& s : sat.signals) {
+        const auto f_hz = core::carrier_frequency_hz(sat.sat.system, s.code);
+        if (core::has_value(s.pseudorange_m)) s.pseudorange_m += core::kSpeedOfLightMps * kOffsetS;
+        if (core::has_value(s.carrier_phase_cyc) && f_hz) s.carrier_phase_cyc += *f_hz * kOffsetS;
+      }
+    }
+  }
+  std::vector<core::ObsEpoch> slow_base;
+  for (std::size_t i = 0; i < base->epochs.size(); i += 5) slow_base.push_back(base->epochs[i]);
+  const fs::path rover_path = tmp / "rover-minus-5ms.obs";
+  const fs::path base_path = tmp / "base-0.2Hz.obs";
+  ASSERT_TRUE(io::write_rinex_obs(rover_path.string(), rover->header, rover->epochs).ok());
+  ASSERT_TRUE(io::write_rinex_obs(base_path.string(), base->header, slow_base).ok());
+  const Eigen::Vector3d p_E_base(4157177.06580187, 671230.476590636, 4774767.03105544);
+  const Eigen::Vector3d truth(4156857.1195929, 673209.028774142, 4774767.03105544);
+  for (const auto mode : {rtk::ArMode::Continuous, rtk::ArMode::Instantaneous}) {
+    auto run =
+        run_rtk("matching", rover_path.string(), base_path.string(),
+                {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
+                p_E_base, [&](app::ProcessConfig& c) {
+                  c.rtk.ar_mode = mode;
+                  c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
+                  c.rtk.troposphere_saastamoinen = false;
+                  c.spp.troposphere_saastamoinen = c.spp.ionosphere_klobuchar = false;
+                });
+    ASSERT_TRUE(run.has_value());
+    eval::EvalOptions options;
+    options.wrong_fix_threshold_m = kWrongFixM;
+    auto stats = eval::evaluate(run->solutions, eval::Truth::constant(truth), options);
+    ASSERT_TRUE(stats.ok());
+    std::cout << "[ RTK      ] instinct static, rover -5 ms, base 0.2 Hz, " << rtk::ar_mode_name(mode) << ": "
+              << stats->fixed().epochs << "/" << run->summary.epochs << " fixed, 3D RMSE " << stats->overall.rmse_3d_m
+              << " m\n";
+    EXPECT_EQ(run->summary.epochs, static_cast<int>(rover->epochs.size()));  // no epoch dropped
+    EXPECT_GE(stats->fixed().epochs, run->summary.epochs * 99 / 100);
+    EXPECT_LE(stats->overall.rmse_3d_m, kMaxStaticRmse3dM);
+    EXPECT_EQ(stats->wrong_fixes, 0);
+  }
+}
+
+}  // namespace
+}  // namespace canyon
