@@ -856,7 +856,8 @@ Result<std::optional<core::ObsEpoch>> RinexObsReader::end_of_body() {
   if (corrupt_epochs_ > valid_epochs_) {
     Error error = first_corruption_;
     error.message = "not usable observation data, " + std::to_string(corrupt_epochs_) + " of the " +
-                    std::to_string(corrupt_epochs_ + valid_epochs_) + " epochs are corrupt; the first: " + error.message;
+                    std::to_string(corrupt_epochs_ + valid_epochs_) +
+                    " epochs are corrupt; the first: " + error.message;
     return error;
   }
   return std::optional<core::ObsEpoch>{};

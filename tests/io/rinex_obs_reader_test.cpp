@@ -268,8 +268,8 @@ TEST(RinexObservationReader, MissingValuesAreNanAndEmptySignalsDropped) {
   EXPECT_TRUE(sats[1].signals.empty());
 }
 
-// ----- corrupt epochs in the body: each is skipped with a warning "file:line: what, epoch skipped (lines a-b)", and the
-// epochs around it are read as if it were not there
+// ----- corrupt epochs in the body: each is skipped with a warning "file:line: what, epoch skipped (lines a-b)", and
+// the epochs around it are read as if it were not there
 
 /// A RINEX 2.11 GPS header of 3 lines (C1 L1 C2 L2: one record line per satellite); the first epoch line is line 4.
 std::string header_v2() {
@@ -292,8 +292,8 @@ struct CorruptCase {
   std::string corrupt;  // put after the valid epoch of second 0 (v3: at line 8, v2: at line 7)
   bool at_end;          // the file ends with it (truncation); else the valid epochs of seconds 2 and 3 follow
   const char* message_part;
-  int line;              // of the warning
-  const char* skipped;   // "lines a-b" the warning reports
+  int line;             // of the warning
+  const char* skipped;  // "lines a-b" the warning reports
 };
 
 std::vector<CorruptCase> corrupt_cases() {
@@ -405,13 +405,13 @@ TEST(RinexObservationReader, SystemWithoutObservationTypesIsSkippedWithOneWarnin
     EXPECT_EQ(e.sats[0].sat, (SatelliteId{Constellation::Gps, 5}));
   }
   ASSERT_EQ(file.warnings.size(), 1u);
-  EXPECT_EQ(file.warnings[0], path + ":7: satellite R05: no observation types declared for GLONASS, records of the " +
-                                  "system skipped");
+  EXPECT_EQ(file.warnings[0],
+            path + ":7: satellite R05: no observation types declared for GLONASS, records of the " + "system skipped");
 }
 
 TEST(RinexObservationReader, DuplicateAndBackwardEpochsAreSkipped) {
   test::TempDir tmp;
-  std::string text = header_v3() + good_epoch(true, 0) + good_epoch(true, 2);  // lines 5 and 8
+  std::string text = header_v3() + good_epoch(true, 0) + good_epoch(true, 2);    // lines 5 and 8
   text += epoch_v3(2021, 9, 22, 6, 30, 2.0, 0, 1) + record_v3("G05", 9e6, 9e7);  // line 11: same time as line 8
   text += epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 1) + record_v3("G05", 9e6, 9e7);  // line 13: earlier
   text += good_epoch(true, 3);
@@ -494,8 +494,8 @@ std::vector<MalformedCase> malformed_cases() {
        "END OF HEADER", 2},
       {"end_of_header_missing_before_data",
        version_line("     3.04") + header_line("G    2 C1C L1C", "SYS / # / OBS TYPES") + valid, "END OF HEADER", 3},
-      {"no_obs_types_v3", version_line("     3.04") + header_line("", "END OF HEADER") + valid,
-       "SYS / # / OBS TYPES", 2},
+      {"no_obs_types_v3", version_line("     3.04") + header_line("", "END OF HEADER") + valid, "SYS / # / OBS TYPES",
+       2},
       {"no_obs_types_v2",
        version_line("     2.11", 'O', 'G') + header_line("X", "MARKER NAME") + header_line("", "END OF HEADER"),
        "# / TYPES OF OBSERV", 3},
