@@ -31,7 +31,8 @@ struct Base {
 Base valid_v3(int epochs) {
   Base b;
   b.text = header_line("     3.04           OBSERVATION DATA    M", "RINEX VERSION / TYPE") +
-           header_line("G    4 C1C L1C D1C S1C", "SYS / # / OBS TYPES") + header_line("R    2 C1C L1C", "SYS / # / OBS TYPES") +
+           header_line("G    4 C1C L1C D1C S1C", "SYS / # / OBS TYPES") +
+           header_line("R    2 C1C L1C", "SYS / # / OBS TYPES") +
            header_line("  2 R01  1 R02 -4", "GLONASS SLOT / FRQ #") +
            header_line("  2021     9    22     6    30    0.0000000     GPS", "TIME OF FIRST OBS") +
            header_line("", "END OF HEADER");
@@ -205,8 +206,8 @@ void expect_only_epoch_affected(const std::vector<core::ObsEpoch>& base, const s
   }
   std::vector<core::ObsEpoch> expected;
   for (std::size_t j = k + 1; j < base.size(); ++j) {
-    const bool in_order = variant == nullptr || variant->flag == core::EpochFlag::CycleSlipRecords ||
-                          base[j].time - variant->time > 0.0;
+    const bool in_order =
+        variant == nullptr || variant->flag == core::EpochFlag::CycleSlipRecords || base[j].time - variant->time > 0.0;
     if (in_order) expected.push_back(base[j]);
   }
   test::expect_same_epochs({out.begin() + static_cast<std::ptrdiff_t>(rest), out.end()}, expected, 0.0);
