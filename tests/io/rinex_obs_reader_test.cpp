@@ -349,7 +349,10 @@ TEST(RinexObservationReader, CorruptEpochsAreSkippedWithAWarningAndTheOthersRead
     const std::string after = c.at_end ? "" : good_epoch(c.v3, 2) + good_epoch(c.v3, 3);
     const RinexObsFile reference = read_ok(tmp.write(std::string(c.name) + "_ref.rnx", before + after));
     ASSERT_EQ(reference.epochs.size(), c.at_end ? 1u : 3u);
-    const std::string path = tmp.write(std::string(c.name) + ".rnx", before + c.corrupt + after);
+    std::string text = before;
+    text += c.corrupt;
+    text += after;
+    const std::string path = tmp.write(std::string(c.name) + ".rnx", text);
     const RinexObsFile file = read_ok(path);
     test::expect_same_epochs(file.epochs, reference.epochs, 0.0);
     ASSERT_EQ(file.warnings.size(), 1u);
