@@ -2,8 +2,9 @@
 //
 // The header is parsed once into RinexObsHeader and a per-system column mapping (column -> signal index and
 // observable kind), so that reading an epoch is a walk over fixed 16-column fields without any lookup by name.
-// Recoverable defects (short epochs, unsupported systems, odd header records) become warnings; anything that makes
-// the following data uninterpretable is an Error naming the file and line.
+// Recoverable defects (short epochs, unsupported systems, odd header records) become warnings; a corrupt epoch in
+// the body is skipped with a warning and reading resumes at the next epoch line; anything that makes the following
+// data uninterpretable (a bad header, a body that is not observation data) is an Error naming the file and line.
 
 #include <algorithm>
 #include <array>
@@ -176,6 +177,14 @@ bool is_blank(std::string_view line) {
   return trim(line).empty();
 }
 
+/// `text` with bytes other than printable ASCII as '?': quoted file content in messages stays one terminal line.
+std::string printable(std::string text) {
+  for (char& c : text) {
+    if (c < ' ' || c > '~') c = '?';
+  }
+  return text;
+}
+
 }  // namespace
 
 /// Per-system column layout of the observation records.
@@ -206,13 +215,14 @@ Result<RinexObsReader> RinexObsReader::open(const std::string& path) {
   return reader;
 }
 
-Error RinexObsReader::end_of_input_error(const std::string& message) const {
-  if (reader_.read_error()) return reader_.error(*reader_.read_error());
-  return reader_.error(message);
+Error RinexObsReader::end_of_input_error(const std::string& message) {
+  if (!reader_.read_error()) return reader_.error(message);
+  read_error_reported_ = true;
+  return reader_.error(message + " (" + *reader_.read_error() + ")");
 }
 
 void RinexObsReader::warn(int line, const std::string& message) {
-  warnings_.push_back(reader_.path() + ":" + std::to_string(line) + ": " + message);
+  warnings_.push_back(reader_.path() + ":" + std::to_string(line) + ": " + printable(message));
 }
 
 Status RinexObsReader::read_version_line() {
@@ -264,7 +274,10 @@ Status RinexObsReader::read_header() {
     if (!next) return end_of_input_error("missing END OF HEADER: the file ends inside the header");
     const std::string_view line = *next;
     const std::string_view label = trim(column(line, 60, 20));
-    if (label == "END OF HEADER") break;
+    if (label == "END OF HEADER") {
+      header_end_line_ = reader_.line_number();
+      break;
+    }
     if (is_blank(line)) {
       warn(reader_.line_number(), "blank line in the header, ignored");
       continue;
@@ -549,9 +562,12 @@ Status RinexObsReader::skip_event_records(int count) {
   bool types_changed = false;
   for (int i = 0; i < count; ++i) {
     const auto next = reader_.next_line();
-    if (!next) return end_of_input_error("file ends inside the header records of an event epoch");
+    if (!next) {
+      warn(reader_.line_number(), end_of_input_error("file ends inside the header records of an event epoch").message);
+      return Ok{};
+    }
     const std::string_view line = *next;
-    if (v3 && line.starts_with('>')) {
+    if (v3 ? line.starts_with('>') : is_epoch_line(line)) {
       warn(reader_.line_number(),
            "event epoch announces " + std::to_string(count) + " header records, " + std::to_string(i) + " present");
       reader_.unread_line();
@@ -590,11 +606,16 @@ Result<std::optional<core::SatelliteId>> RinexObsReader::resolve_satellite(std::
   if (text[0] == ' ' && version_code_ < 300) text[0] = 'G';  // RINEX 2: blank means GPS
   const std::string_view id(text, 3);
   if (const auto sat = core::parse_satellite(id)) {
-    if (!mapping_->systems[static_cast<std::size_t>(system_index(sat->system))].declared) {
-      return reader_.error(std::string("satellite ") + sat->to_string() + ": no observation types declared for " +
-                           std::string(core::constellation_name(sat->system)));
+    if (mapping_->systems[static_cast<std::size_t>(system_index(sat->system))].declared) {
+      return std::optional<core::SatelliteId>(*sat);
     }
-    return std::optional<core::SatelliteId>(*sat);
+    if (warned_systems_.find(text[0]) == std::string::npos) {
+      warned_systems_.push_back(text[0]);
+      warn(reader_.line_number(), "satellite " + sat->to_string() + ": no observation types declared for " +
+                                      std::string(core::constellation_name(sat->system)) +
+                                      ", records of the system skipped");
+    }
+    return std::optional<core::SatelliteId>{};
   }
   const bool numeric = parse_int(id.substr(1)).has_value();
   if (numeric && is_other_system(text[0])) {
@@ -622,6 +643,10 @@ Status RinexObsReader::parse_fields(std::string_view line, std::size_t first_col
     const std::size_t pos = first_col + kFieldWidth * i;
     if (pos >= line.size()) break;
     const std::string_view field = column(line, pos, kValueWidth);
+    if (field.size() < kValueWidth && !is_blank(field)) {  // values are right-aligned: the line was cut
+      return reader_.error("observation value '" + std::string(trim(field)) + "' cut short in column " +
+                           std::to_string(pos + 1) + " (the line ends inside the field)");
+    }
     const auto value = parse_double(field, 0.0);
     if (!value) {
       return reader_.error("bad observation value '" + std::string(trim(field)) + "' in column " +
@@ -704,6 +729,10 @@ Status RinexObsReader::read_sat_list_v2(std::string_view epoch_line, int count) 
     if (k > 0 && slot == 0) {
       const auto next = reader_.next_line();
       if (!next) return end_of_input_error("file ends inside the satellite list of an epoch");
+      if (is_epoch_line(*next)) {
+        return reader_.error("epoch announces " + std::to_string(count) + " satellites, " + std::to_string(k) +
+                             " listed");
+      }
       line.assign(*next);
     }
     const std::string_view token = column(line, 32 + 3 * slot, 3);
@@ -732,29 +761,128 @@ Status RinexObsReader::read_satellites_v2(core::ObsEpoch& epoch) {
       if (!*sat) continue;
       const std::size_t first = l * kV2FieldsPerLine;
       const std::size_t n = std::min(kV2FieldsPerLine, types - std::min(types, first));
-      if (Status s = parse_fields(*next, 0, first, n, (*sat)->system); !s.ok()) return s;
+      if (Status s = parse_fields(*next, 0, first, n, (*sat)->system); !s.ok()) {
+        if (!is_epoch_line(*next)) return s;
+        return reader_.error("epoch line where a satellite record was expected: records of " +
+                             std::to_string(sat_tokens_.size()) + " satellites announced, fewer present");
+      }
     }
     if (*sat) emit_satellite(**sat, epoch);
   }
   return Ok{};
 }
 
+bool RinexObsReader::is_epoch_line(std::string_view line) const {
+  const bool v3 = version_code_ >= 300;
+  if (v3 && !line.starts_with('>')) return false;
+  EpochLine fields;
+  if (parse_epoch_line(line, v3, fields)) return false;
+  if (v3 || (fields.flag >= 2 && fields.flag <= 5)) return true;
+  const int listed = std::min(fields.count, static_cast<int>(kV2SatsPerLine));
+  for (int k = 0; k < listed; ++k) {
+    const std::string_view token = column(line, 32 + 3 * static_cast<std::size_t>(k), 3);
+    const char system = token.empty() ? ' ' : token[0];
+    const bool letter = system == ' ' || core::constellation_from_letter(system) || is_other_system(system);
+    const auto number = parse_int(column(token, 1, 2));
+    if (!letter || !number || *number <= 0) return false;
+  }
+  return true;
+}
+
+Status RinexObsReader::read_records(core::ObsEpoch& epoch, std::string_view line, int count, int epoch_line) {
+  if (version_code_ >= 300) return read_satellites_v3(epoch, count, epoch_line);
+  if (Status s = read_sat_list_v2(line, count); !s.ok()) return s;
+  return read_satellites_v2(epoch);
+}
+
+Result<int> RinexObsReader::resynchronise() {
+  int garbled_epoch_lines = 0;
+  for (;;) {
+    const auto next = reader_.next_line();
+    if (!next) return garbled_epoch_lines;
+    if (is_epoch_line(*next)) {
+      reader_.unread_line();
+      return garbled_epoch_lines;
+    }
+    if (version_code_ >= 300 && next->starts_with('>')) ++garbled_epoch_lines;
+    if (!epoch_line_seen_ && reader_.line_number() - header_end_line_ >= kMaxLinesBeforeFirstEpoch) {
+      return reader_.error("no epoch line in the " + std::to_string(kMaxLinesBeforeFirstEpoch) +
+                           " lines after the header: not RINEX " + format_version(header_.version) +
+                           " observation data");
+    }
+  }
+}
+
+Status RinexObsReader::skip_corrupt_epoch(const Error& problem, int first_line) {
+  // The line where the problem showed may be the next epoch's (an epoch announcing more records than it holds):
+  // it is examined again, unless it is the corrupt epoch's own first line.
+  if (!reader_.ended() && reader_.line_number() > first_line) reader_.unread_line();
+  const auto garbled = resynchronise();
+  if (!garbled.ok()) return garbled.error();
+  const int epochs = 1 + *garbled;
+  const int last_line = std::max(first_line, reader_.line_number());
+  std::string message = problem.message + ", ";
+  message += epochs == 1 ? "epoch" : std::to_string(epochs) + " epochs";
+  message += " skipped (";
+  message += last_line == first_line ? "line " + std::to_string(first_line)
+                                     : "lines " + std::to_string(first_line) + "-" + std::to_string(last_line);
+  message += ")";
+  warn(problem.line, message);
+  if (corrupt_epochs_ == 0) first_corruption_ = Error{printable(message), reader_.path(), problem.line};
+  corrupt_epochs_ += epochs;
+  return Ok{};
+}
+
+bool RinexObsReader::in_time_order(const core::ObsEpoch& epoch, const core::CalendarTime& time, int epoch_line) {
+  if (epoch.flag == core::EpochFlag::CycleSlipRecords) return true;  // repeats the time of the epoch it amends
+  if (last_time_ && epoch.time - *last_time_ <= 0.0) {
+    const bool same = epoch.time - *last_time_ == 0.0;
+    std::string message = "epoch " + core::format_calendar(time, 7);
+    message += same ? " repeats the time of" : " is earlier than";
+    message += " the epoch of line " + std::to_string(last_time_line_) + ", epoch skipped";
+    warn(epoch_line, message);
+    return false;
+  }
+  last_time_ = epoch.time;
+  last_time_line_ = epoch_line;
+  return true;
+}
+
+Result<std::optional<core::ObsEpoch>> RinexObsReader::end_of_body() {
+  if (reader_.read_error() && !read_error_reported_) {
+    read_error_reported_ = true;
+    warn(reader_.line_number(), *reader_.read_error() + ": reading stops here, the epochs before are kept");
+  }
+  if (corrupt_epochs_ > valid_epochs_) {
+    Error error = first_corruption_;
+    error.message = "not usable observation data, " + std::to_string(corrupt_epochs_) + " of the " +
+                    std::to_string(corrupt_epochs_ + valid_epochs_) +
+                    " epochs are corrupt; the first: " + error.message;
+    return error;
+  }
+  return std::optional<core::ObsEpoch>{};
+}
+
 Result<std::optional<core::ObsEpoch>> RinexObsReader::next() {
   const bool v3 = version_code_ >= 300;
   for (;;) {
     const auto next = reader_.next_line();
-    if (!next) {
-      if (reader_.read_error()) return reader_.error(*reader_.read_error());
-      return std::optional<core::ObsEpoch>{};
-    }
+    if (!next) return end_of_body();
     const std::string_view line = *next;
     if (is_blank(line)) continue;
-    if (v3 && !line.starts_with('>')) {
-      return reader_.error("expected an epoch line starting with '>', got '" + std::string(column(line, 0, 20)) + "'");
-    }
-    EpochLine fields;
-    if (const auto problem = parse_epoch_line(line, v3, fields)) return reader_.error(*problem);
     const int epoch_line = reader_.line_number();
+    EpochLine fields;
+    std::optional<std::string> problem;
+    if (v3 && !line.starts_with('>')) {
+      problem = "expected an epoch line starting with '>', got '" + std::string(column(line, 0, 20)) + "'";
+    } else {
+      problem = parse_epoch_line(line, v3, fields);
+    }
+    if (problem) {
+      if (Status s = skip_corrupt_epoch(reader_.error(*problem), epoch_line); !s.ok()) return s.error();
+      continue;
+    }
+    epoch_line_seen_ = true;
     if (fields.flag >= 2 && fields.flag <= 5) {
       if (Status s = skip_event_records(fields.count); !s.ok()) return s.error();
       continue;
@@ -763,12 +891,14 @@ Result<std::optional<core::ObsEpoch>> RinexObsReader::next() {
     epoch.time = to_gps(fields.time);
     epoch.flag = static_cast<core::EpochFlag>(fields.flag);
     epoch.receiver_clock_offset_s = fields.clock_offset_s;
-    if (v3) {
-      if (Status s = read_satellites_v3(epoch, fields.count, epoch_line); !s.ok()) return s.error();
-    } else {
-      if (Status s = read_sat_list_v2(line, fields.count); !s.ok()) return s.error();
-      if (Status s = read_satellites_v2(epoch); !s.ok()) return s.error();
+    Status read = read_records(epoch, line, fields.count, epoch_line);
+    if (reader_.line_cut()) read = end_of_input_error("file ends inside an epoch, its last line cut short");
+    if (!read.ok()) {
+      if (Status s = skip_corrupt_epoch(read.error(), epoch_line); !s.ok()) return s.error();
+      continue;
     }
+    if (!in_time_order(epoch, fields.time, epoch_line)) continue;
+    ++valid_epochs_;
     return std::optional<core::ObsEpoch>(std::move(epoch));
   }
 }

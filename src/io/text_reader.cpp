@@ -78,9 +78,13 @@ std::optional<std::string_view> TextReader::next_line() {
       break;
     }
     if (!fill()) {
-      if (buffer_pos_ >= buffer_.size()) return std::nullopt;
+      if (buffer_pos_ >= buffer_.size()) {
+        ended_ = true;
+        return std::nullopt;
+      }
       line_.assign(buffer_, buffer_pos_, std::string::npos);  // last line without a newline
       buffer_pos_ = buffer_.size();
+      line_cut_ = read_error_.has_value();
       break;
     }
   }

@@ -1,6 +1,10 @@
-// The `canyon` command run as a real process: exit codes and messages for good and bad input.
+// The `canyon` command run as a real process: exit codes and messages for good and bad input, including a rover
+// file with one corrupt epoch in the middle (issue 3: a clear message, the epoch handled, processing continues).
 
+#include <cmath>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -17,6 +21,11 @@ test::CommandResult canyon(const std::string& args) {
 
 const fs::path kGsiRover = test::shared_data() / "rtklib-test-gsi-2005/07590920.05o";
 const fs::path kGsiNav = test::shared_data() / "rtklib-test-gsi-2005/07590920.05n";
+// 60 epochs at 1 Hz from 12:00:00 GPST; epoch i's line is 33 + 24 i (23 satellites each).
+const fs::path kStaticDir = test::shared_data() / "cssrlib-static-doy078";
+const fs::path kStaticRover = kStaticDir / "SEPT078M1.21O";
+const fs::path kStaticBase = kStaticDir / "3034078M1.21O";
+const fs::path kStaticNav = kStaticDir / "SEPT078M.21P";
 
 TEST(CanyonCli, NoSubcommandIsAUsageError) {
   const auto r = canyon("");
@@ -83,6 +92,112 @@ TEST(CanyonCli, NavigationFileGivenAsObservationsIsRejected) {
   const auto r = canyon("process --rover " + kGsiNav.string() + " --nav " + kGsiNav.string() + " --out /tmp/x.pos");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find(kGsiNav.string()), std::string::npos) << r.output;
+}
+
+std::vector<std::string> read_lines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+void write_lines(const fs::path& path, const std::vector<std::string>& lines) {
+  std::ofstream out(path);
+  for (const std::string& line : lines) out << line << "\n";
+}
+
+/// Times of week (ms) of the solutions in a .pos file.
+std::vector<long> solution_times_ms(const fs::path& pos) {
+  auto sols = io::read_pos_file(pos.string());
+  EXPECT_TRUE(sols.ok()) << sols.error().to_string();
+  std::vector<long> times;
+  if (!sols) return times;
+  for (const auto& s : *sols) times.push_back(std::lround(s.time.tow_s * 1000.0));
+  return times;
+}
+
+test::CommandResult process(const std::string& mode, const fs::path& rover, const fs::path& out) {
+  return canyon("process -q --mode " + mode + " --rover " + rover.string() + " --base " + kStaticBase.string() +
+                " --nav " + kStaticNav.string() + " --out " + out.string());
+}
+
+/// An edit of one line of a file: `text` written over it from `column`, or the line cut there if `text` is empty.
+struct Corruption {
+  const char* name;
+  int line;  // 1-based
+  std::size_t column;
+  std::string text;
+  const char* warning;  // expected after "file:line: "
+  bool epoch_kept;      // the reader recovers the epoch itself
+};
+
+std::string corrupt(const std::string& line, const Corruption& c) {
+  if (c.text.empty()) return line.substr(0, c.column);
+  std::string out = line;
+  out.replace(c.column, c.text.size(), c.text);
+  return out;
+}
+
+TEST(CanyonCli, CorruptRoverEpochIsSkippedWithAWarningAndEveryOtherEpochSolved) {
+  if (!fs::exists(kStaticRover)) GTEST_SKIP() << "shared dataset not present: " << kStaticRover;
+  constexpr int kEpochLine = 33 + 24 * 30;  // 12:00:30, the 31st of 60 epochs
+  constexpr long kEpochTowMs = 475230000;
+  const Corruption corruptions[] = {
+      {"garbled_epoch_line", kEpochLine, 16, "x", "bad epoch time", false},  // minute
+      {"garbled_observation_value", kEpochLine + 5, 6, "12x45", "bad observation value '212x4552.829' in column 4",
+       false},
+      {"truncated_satellite_line", kEpochLine + 5, 30, "", "observation value '124140198.' cut short in column 20",
+       false},
+      {"more_satellites_announced", kEpochLine, 33, "30", "epoch announces 30 satellites, 23 present", true},
+  };
+  const fs::path dir = test::temp_dir("cli_corrupt");
+  for (const char* mode : {"spp", "rtk"}) {
+    SCOPED_TRACE(mode);
+    const auto original = process(mode, kStaticRover, dir / "original.pos");
+    ASSERT_EQ(original.exit_code, 0) << original.output;
+    const std::vector<long> all = solution_times_ms(dir / "original.pos");
+    ASSERT_EQ(all.size(), 60u);
+    ASSERT_EQ(all[30], kEpochTowMs);
+    for (const Corruption& c : corruptions) {
+      SCOPED_TRACE(c.name);
+      std::vector<std::string> lines = read_lines(kStaticRover);
+      std::string& line = lines.at(static_cast<std::size_t>(c.line - 1));
+      line = corrupt(line, c);
+      const fs::path rover = dir / (std::string(c.name) + ".21O");
+      write_lines(rover, lines);
+      const fs::path out = dir / (std::string(c.name) + "_" + mode + ".pos");
+      const auto r = process(mode, rover, out);
+      EXPECT_EQ(r.exit_code, 0) << r.output;
+      const std::string where = rover.string() + ":" + std::to_string(c.line) + ": ";
+      EXPECT_NE(r.output.find("canyon: warning: " + where + c.warning), std::string::npos) << r.output;
+      if (!c.epoch_kept) {
+        EXPECT_NE(r.output.find("epoch skipped (lines " + std::to_string(kEpochLine) + "-" +
+                                std::to_string(kEpochLine + 23) + ")"),
+                  std::string::npos)
+            << r.output;
+      }
+      std::vector<long> expected = all;
+      if (!c.epoch_kept) expected.erase(expected.begin() + 30);
+      EXPECT_EQ(solution_times_ms(out), expected);
+    }
+  }
+}
+
+TEST(CanyonCli, RoverFileWithAHeaderButNoObservationsIsRejected) {
+  if (!fs::exists(kStaticRover)) GTEST_SKIP() << "shared dataset not present: " << kStaticRover;
+  // The rover's header followed by navigation records: a clear error, not "0 epochs".
+  std::vector<std::string> lines = read_lines(kStaticRover);
+  lines.resize(32);  // up to END OF HEADER
+  const std::vector<std::string> nav = read_lines(kStaticNav);
+  lines.insert(lines.end(), nav.begin() + 10, nav.end());
+  const fs::path rover = test::temp_dir("cli_corrupt") / "header_and_nav.21O";
+  write_lines(rover, lines);
+  const auto r = process("spp", rover, test::temp_dir("cli_corrupt") / "x.pos");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(
+      r.output.find("canyon: error: " + rover.string() + ":1032: no epoch line in the 1000 lines after the header"),
+      std::string::npos)
+      << r.output;
 }
 
 }  // namespace

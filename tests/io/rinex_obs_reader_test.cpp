@@ -1,6 +1,8 @@
 // RINEX observation reader on small files written by the tests: RINEX 2 layout (type continuation lines, records
 // wrapping after five fields, satellite lists beyond twelve), type mapping, time systems, event epochs, skipped
-// systems, recoverable defects, and malformed files that must give an Error naming the file and the line.
+// systems, recoverable defects; corrupt epochs in the body, skipped with a warning naming the file and the line while
+// every other epoch is read unchanged; and malformed headers or bodies that must give an Error naming the file and
+// the line.
 
 #include <cmath>
 #include <string>
@@ -266,6 +268,202 @@ TEST(RinexObservationReader, MissingValuesAreNanAndEmptySignalsDropped) {
   EXPECT_TRUE(sats[1].signals.empty());
 }
 
+// ----- corrupt epochs in the body: each is skipped with a warning "file:line: what, epoch skipped (lines a-b)", and
+// the epochs around it are read as if it were not there
+
+/// A RINEX 2.11 GPS header of 3 lines (C1 L1 C2 L2: one record line per satellite); the first epoch line is line 4.
+std::string header_v2() {
+  return version_line("     2.11", 'O', 'G') + header_line("     4    C1    L1    C2    L2", "# / TYPES OF OBSERV") +
+         header_line("", "END OF HEADER");
+}
+
+/// A valid epoch of 3 lines (epoch line, G05, G07) at second `s`, values depending on `s`.
+std::string good_epoch(bool v3, int s) {
+  const double c = 2.1e7 + 1000.0 * s;
+  const double l = 1.1e8 + 5000.0 * s;
+  if (v3) return epoch_v3(2021, 9, 22, 6, 30, s, 0, 2) + record_v3("G05", c, l, s % 2) + record_v3("G07", c + 1e6, l);
+  const std::string record = obs_field(c) + obs_field(l, s % 2) + obs_field(c + 2.0) + obs_field(l * 0.78) + "\n";
+  return epoch_v2(2021, 9, 22, 6, 30, s, 0, 2) + "G05G07\n" + record + record;
+}
+
+struct CorruptCase {
+  const char* name;
+  bool v3;
+  std::string corrupt;  // put after the valid epoch of second 0 (v3: at line 8, v2: at line 7)
+  bool at_end;          // the file ends with it (truncation); else the valid epochs of seconds 2 and 3 follow
+  const char* message_part;
+  int line;             // of the warning
+  const char* skipped;  // "lines a-b" the warning reports
+};
+
+std::vector<CorruptCase> corrupt_cases() {
+  const std::string g05 = record_v3("G05", 2.1e7, 1.1e8);
+  const std::string g07 = record_v3("G07", 2.2e7, 1.2e8);
+  const std::string v2_record = obs_field(2.1e7) + obs_field(1.1e8) + "\n";
+  return {
+      {"bad_epoch_date", true, epoch_v3(2021, 13, 22, 6, 30, 1.0, 0, 2) + g05 + g07, false, "bad epoch date", 8,
+       "lines 8-10"},
+      {"bad_satellite_count", true, "> 2021 09 22 06 30  1.0000000  0 x1\n" + g05, false, "bad satellite count", 8,
+       "lines 8-9"},
+      {"non_numeric_seconds", true, "> 2021 09 22 06 30  1.00a0000  0  2\n" + g05 + g07, false, "bad epoch time", 8,
+       "lines 8-10"},
+      {"bad_epoch_flag", true, "> 2021 09 22 06 30  1.0000000  9  2\n" + g05 + g07, false, "bad epoch flag", 8,
+       "lines 8-10"},
+      {"epoch_line_cut_short", true, "> 2021 09 22 06 30  1.00\n" + g05 + g07, false, "bad satellite count", 8,
+       "lines 8-10"},
+      {"data_line_without_epoch", true, g05, false, "expected an epoch line starting with '>', got 'G05", 8, "line 8"},
+      {"garbage_lines", true, "\x01\x02\xff binary\n\n>> not an epoch\n", false,
+       "expected an epoch line starting with '>', got '??? binary', 2 epochs", 8, "lines 8-10"},
+      {"bad_satellite", true, epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 2) + "X05" + obs_field(2.1e7) + "\n" + g07, false,
+       "bad satellite 'X05'", 9, "lines 8-10"},
+      {"bad_observation_value", true, epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 2) + "G05  21000x00.000\n" + g07, false,
+       "bad observation value '21000x00.000' in column 4", 9, "lines 8-10"},
+      {"record_line_cut_short", true, epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 2) + g05.substr(0, 30) + "\n" + g07, false,
+       "observation value '110000000.' cut short in column 20", 9, "lines 8-10"},
+      {"truncated_in_epoch_v3", true, epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 3) + g05, true,
+       "file ends inside an epoch: 3 satellites announced, 1 present", 9, "lines 8-9"},
+      {"truncated_in_record_line_v3", true, epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 2) + g05 + g07.substr(0, 25), true,
+       "cut short in column 20", 10, "lines 8-10"},
+      {"truncated_in_epoch_v2", false, epoch_v2(2021, 9, 22, 6, 30, 1.0, 0, 2) + "G05G07\n" + v2_record, true,
+       "file ends inside an epoch", 8, "lines 7-8"},
+      {"satellite_list_short_v2", false, epoch_v2(2021, 9, 22, 6, 30, 1.0, 0, 3) + "G05G07\n" + v2_record + v2_record,
+       false, "3 satellites, 2 listed", 7, "lines 7-9"},
+      {"bad_observation_value_v2", false,
+       epoch_v2(2021, 9, 22, 6, 30, 1.0, 0, 2) + "G05G07\n" + v2_record + "  21000x00.000\n", false,
+       "bad observation value '21000x00.000' in column 1", 9, "lines 7-9"},
+      // The list names three satellites but only two records follow: the next epoch line is where the third record
+      // should be; it is recognised, not swallowed.
+      {"fewer_records_than_listed_v2", false,
+       epoch_v2(2021, 9, 22, 6, 30, 1.0, 0, 3) + "G05G07G09\n" + v2_record + v2_record, false,
+       "epoch line where a satellite record was expected", 10, "lines 7-9"},
+      {"garbled_epoch_line_v2", false, " 21  9 2x  6 30  1.0000000  0  2G05G07\n" + v2_record + v2_record, false,
+       "bad epoch time", 7, "lines 7-9"},
+  };
+}
+
+TEST(RinexObservationReader, CorruptEpochsAreSkippedWithAWarningAndTheOthersRead) {
+  test::TempDir tmp;
+  for (const CorruptCase& c : corrupt_cases()) {
+    SCOPED_TRACE(c.name);
+    const std::string before = (c.v3 ? header_v3() : header_v2()) + good_epoch(c.v3, 0);
+    const std::string after = c.at_end ? "" : good_epoch(c.v3, 2) + good_epoch(c.v3, 3);
+    const RinexObsFile reference = read_ok(tmp.write(std::string(c.name) + "_ref.rnx", before + after));
+    ASSERT_EQ(reference.epochs.size(), c.at_end ? 1u : 3u);
+    std::string text = before;
+    text += c.corrupt;
+    text += after;
+    const std::string path = tmp.write(std::string(c.name) + ".rnx", text);
+    const RinexObsFile file = read_ok(path);
+    test::expect_same_epochs(file.epochs, reference.epochs, 0.0);
+    ASSERT_EQ(file.warnings.size(), 1u);
+    const std::string& warning = file.warnings[0];
+    EXPECT_EQ(warning.rfind(path + ":" + std::to_string(c.line) + ": ", 0), 0u) << warning;
+    EXPECT_NE(warning.find(c.message_part), std::string::npos) << warning;
+    EXPECT_NE(warning.find(std::string(" skipped (") + c.skipped + ")"), std::string::npos) << warning;
+  }
+}
+
+TEST(RinexObservationReader, EpochWithFewerSatellitesThanAnnouncedKeepsItsRecordsAndTheNextEpoch) {
+  test::TempDir tmp;
+  // RINEX 3: the next '>' line ends the short epoch (see ShortEpochIsRecoveredWithAWarning); RINEX 2 lists its
+  // satellites, so a record missing there cannot be told which, and the epoch is skipped (above).
+  std::string text = header_v3() + good_epoch(true, 0);
+  text += epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 5) + record_v3("G05", 2.1e7, 1.1e8);  // line 8: 5 announced, 1 present
+  text += good_epoch(true, 2);
+  const std::string path = tmp.write("short.rnx", text);
+  const RinexObsFile file = read_ok(path);
+  ASSERT_EQ(file.epochs.size(), 3u);
+  EXPECT_EQ(file.epochs[1].sats.size(), 1u);
+  EXPECT_EQ(file.epochs[2].sats.size(), 2u);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0], path + ":8: epoch announces 5 satellites, 1 present");
+}
+
+TEST(RinexObservationReader, EpochWithMoreRecordsThanAnnouncedKeepsItsCountAndSkipsTheRest) {
+  test::TempDir tmp;
+  std::string text = header_v3() + good_epoch(true, 0);
+  text += epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 1) + record_v3("G05", 2.1e7, 1.1e8) + record_v3("G07", 2.2e7, 1.2e8);
+  text += good_epoch(true, 2);
+  const std::string path = tmp.write("long.rnx", text);
+  const RinexObsFile file = read_ok(path);
+  ASSERT_EQ(file.epochs.size(), 3u);
+  EXPECT_EQ(file.epochs[1].sats.size(), 1u);
+  EXPECT_EQ(file.epochs[2].sats.size(), 2u);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0].rfind(path + ":10: expected an epoch line", 0), 0u) << file.warnings[0];
+}
+
+TEST(RinexObservationReader, SystemWithoutObservationTypesIsSkippedWithOneWarning) {
+  test::TempDir tmp;
+  // The header declares GPS only; GLONASS records are skipped, the epochs and their GPS records kept.
+  std::string text = header_v3();
+  for (int s = 0; s < 2; ++s) {
+    text += epoch_v3(2021, 9, 22, 6, 30, s, 0, 2) + record_v3("G05", 2.1e7, 1.1e8) + "R05" + obs_field(2.1e7) + "\n";
+  }
+  const std::string path = tmp.write("glonass.rnx", text);
+  const RinexObsFile file = read_ok(path);
+  ASSERT_EQ(file.epochs.size(), 2u);
+  for (const auto& e : file.epochs) {
+    ASSERT_EQ(e.sats.size(), 1u);
+    EXPECT_EQ(e.sats[0].sat, (SatelliteId{Constellation::Gps, 5}));
+  }
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0],
+            path + ":7: satellite R05: no observation types declared for GLONASS, records of the " + "system skipped");
+}
+
+TEST(RinexObservationReader, DuplicateAndBackwardEpochsAreSkipped) {
+  test::TempDir tmp;
+  std::string text = header_v3() + good_epoch(true, 0) + good_epoch(true, 2);    // lines 5 and 8
+  text += epoch_v3(2021, 9, 22, 6, 30, 2.0, 0, 1) + record_v3("G05", 9e6, 9e7);  // line 11: same time as line 8
+  text += epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 1) + record_v3("G05", 9e6, 9e7);  // line 13: earlier
+  text += good_epoch(true, 3);
+  const std::string path = tmp.write("order.rnx", text);
+  const RinexObsFile file = read_ok(path);
+  const RinexObsFile reference =
+      read_ok(tmp.write("ref.rnx", header_v3() + good_epoch(true, 0) + good_epoch(true, 2) + good_epoch(true, 3)));
+  test::expect_same_epochs(file.epochs, reference.epochs, 0.0);
+  ASSERT_EQ(file.warnings.size(), 2u);
+  EXPECT_EQ(file.warnings[0],
+            path + ":11: epoch 2021-09-22 06:30:02.0000000 repeats the time of the epoch of line 8, epoch skipped");
+  EXPECT_EQ(file.warnings[1],
+            path + ":13: epoch 2021-09-22 06:30:01.0000000 is earlier than the epoch of line 8, epoch skipped");
+}
+
+TEST(RinexObservationReader, CorruptFirstEpochIsSkipped) {
+  test::TempDir tmp;
+  const std::string text = header_v3() + "> 2021 09 22 06 30  0.0000000  0 x2\n" + record_v3("G05", 2.1e7, 1.1e8) +
+                           record_v3("G07", 2.2e7, 1.2e8) + good_epoch(true, 1) + good_epoch(true, 2);
+  const std::string path = tmp.write("first.rnx", text);
+  const RinexObsFile file = read_ok(path);
+  ASSERT_EQ(file.epochs.size(), 2u);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0].rfind(path + ":5: bad satellite count", 0), 0u) << file.warnings[0];
+}
+
+TEST(RinexObservationReader, TruncatedEventRecordsEndTheFileWithAWarning) {
+  test::TempDir tmp;
+  const std::string text =
+      header_v3() + good_epoch(true, 0) + epoch_v3(2021, 9, 22, 6, 30, 1.0, 4, 3) + header_line("X", "COMMENT");
+  const std::string path = tmp.write("event.rnx", text);
+  const RinexObsFile file = read_ok(path);
+  ASSERT_EQ(file.epochs.size(), 1u);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0], path + ":9: file ends inside the header records of an event epoch");
+}
+
+TEST(RinexObservationReader, Rinex2EventRecordsStopAtTheNextEpochLine) {
+  test::TempDir tmp;
+  // A flag 4 epoch announcing 3 header records holds one: the epoch line after it is not taken as a record.
+  const std::string text = header_v2() + good_epoch(false, 0) + epoch_v2(2021, 9, 22, 6, 30, 1.0, 4, 3) + "\n" +
+                           header_line("X", "COMMENT") + good_epoch(false, 2);
+  const std::string path = tmp.write("event.21o", text);
+  const RinexObsFile file = read_ok(path);
+  ASSERT_EQ(file.epochs.size(), 2u);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0], path + ":9: event epoch announces 3 header records, 1 present");
+}
+
 // ----- malformed files: each gives an Error naming the problem, the file and the line
 
 struct MalformedCase {
@@ -275,8 +473,20 @@ struct MalformedCase {
   int line;
 };
 
+/// A body of `lines` lines that are not observation data (navigation records).
+std::string nav_lines(int lines) {
+  std::string text;
+  for (int i = 0; i < lines; ++i) {
+    text += i % 8 == 0 ? "G01 2021 09 22 06 00 00 1.234567890123E-04-1.136868377216E-12 0.000000000000E+00\n"
+                       : "     1.000000000000E+01 2.000000000000E+01 3.000000000000E+01 4.000000000000E+01\n";
+  }
+  return text;
+}
+
 std::vector<MalformedCase> malformed_cases() {
-  const std::string good_epoch = epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 1) + record_v3("G05", 2.1e7, 1.1e8);
+  const std::string valid = epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 1) + record_v3("G05", 2.1e7, 1.1e8);
+  const std::string valid_later = epoch_v3(2021, 9, 22, 6, 30, 1.0, 0, 1) + record_v3("G05", 2.1e7, 1.1e8);
+  const std::string bad_epoch = "> 2021 09 22 06 30  0.0000000  9  1\n" + record_v3("G05", 2.1e7, 1.1e8);
   return {
       {"empty", "", "empty file", 0},
       {"comment_first", header_line("made by hand", "COMMENT") + header_v3(), "RINEX VERSION / TYPE", 1},
@@ -286,10 +496,9 @@ std::vector<MalformedCase> malformed_cases() {
       {"end_of_header_missing_at_eof", version_line("     3.04") + header_line("G    2 C1C L1C", "SYS / # / OBS TYPES"),
        "END OF HEADER", 2},
       {"end_of_header_missing_before_data",
-       version_line("     3.04") + header_line("G    2 C1C L1C", "SYS / # / OBS TYPES") + good_epoch, "END OF HEADER",
-       3},
-      {"no_obs_types_v3", version_line("     3.04") + header_line("", "END OF HEADER") + good_epoch,
-       "SYS / # / OBS TYPES", 2},
+       version_line("     3.04") + header_line("G    2 C1C L1C", "SYS / # / OBS TYPES") + valid, "END OF HEADER", 3},
+      {"no_obs_types_v3", version_line("     3.04") + header_line("", "END OF HEADER") + valid, "SYS / # / OBS TYPES",
+       2},
       {"no_obs_types_v2",
        version_line("     2.11", 'O', 'G') + header_line("X", "MARKER NAME") + header_line("", "END OF HEADER"),
        "# / TYPES OF OBSERV", 3},
@@ -297,33 +506,6 @@ std::vector<MalformedCase> malformed_cases() {
        version_line("     3.04") + header_line("G   20 C1C L1C", "SYS / # / OBS TYPES") +
            header_line("", "END OF HEADER"),
        "fewer types than announced", 2},
-      {"bad_epoch_date", header_v3() + epoch_v3(2021, 13, 22, 6, 30, 0.0, 0, 1) + record_v3("G05", 2.1e7, 1.1e8),
-       "bad epoch date", 5},
-      {"bad_satellite_count", header_v3() + "> 2021 09 22 06 30  0.0000000  0 x1\n", "bad satellite count", 5},
-      {"non_numeric_seconds", header_v3() + good_epoch + "> 2021 09 22 06 30  0.00a0000  0  1\n", "bad epoch time", 7},
-      {"bad_epoch_flag", header_v3() + "> 2021 09 22 06 30  0.0000000  9  1\n", "bad epoch flag", 5},
-      {"data_line_without_epoch", header_v3() + good_epoch + record_v3("G05", 2.1e7, 1.1e8), "expected an epoch line",
-       7},
-      {"truncated_in_epoch_v3", header_v3() + epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 3) + record_v3("G05", 2.1e7, 1.1e8),
-       "file ends inside an epoch", 6},
-      {"truncated_in_epoch_v2",
-       version_line("     2.11", 'O', 'G') +
-           header_line("     6    C1    L1    C2    L2    S1    S2", "# / TYPES OF OBSERV") +
-           header_line("", "END OF HEADER") + epoch_v2(2021, 9, 22, 6, 30, 0.0, 0, 2) + "G05G07\n" + obs_field(2.1e7) +
-           "\n" + obs_field(2.1e7) + "\n" + obs_field(2.2e7) + "\n",
-       "file ends inside an epoch", 7},
-      {"satellite_list_short_v2",
-       version_line("     2.11", 'O', 'G') + header_line("     1    C1", "# / TYPES OF OBSERV") +
-           header_line("", "END OF HEADER") + epoch_v2(2021, 9, 22, 6, 30, 0.0, 0, 3) + "G05G07\n",
-       "3 satellites, 2 listed", 4},
-      {"system_without_obs_types",
-       header_v3() + epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 2) + record_v3("G05", 2.1e7, 1.1e8) + "R05" +
-           obs_field(2.1e7) + "\n",
-       "no observation types declared for GLONASS", 7},
-      {"bad_satellite", header_v3() + epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 1) + "X05" + obs_field(2.1e7) + "\n",
-       "bad satellite 'X05'", 6},
-      {"bad_observation_value", header_v3() + epoch_v3(2021, 9, 22, 6, 30, 0.0, 0, 1) + "G05  21000x00.000\n",
-       "bad observation value '21000x00.000'", 6},
       {"binary_garbage",
        std::string("\x7f"
                    "ELF\x02\x01\x00\xff\xfe garbage\x01\n\x03\x04",
@@ -336,6 +518,19 @@ std::vector<MalformedCase> malformed_cases() {
        version_line("     3.04") +
            header_line("  2021    19    22     6    30    0.0000000     GPS", "TIME OF FIRST OBS"),
        "TIME OF FIRST OBS", 2},
+      // Bodies that are not observation data: an Error as soon as that is clear, naming where.
+      {"only_corrupt_epoch", header_v3() + bad_epoch, "not usable observation data, 1 of the 1 epochs are corrupt", 5},
+      {"more_corrupt_than_valid", header_v3() + valid + bad_epoch + valid_later + bad_epoch + bad_epoch,
+       "3 of the 5 epochs are corrupt; the first: bad epoch flag '9', epoch skipped (lines 7-8)", 7},
+      {"short_navigation_body", header_v3() + nav_lines(40), "1 of the 1 epochs are corrupt", 5},
+      {"long_navigation_body", header_v3() + nav_lines(RinexObsReader::kMaxLinesBeforeFirstEpoch + 10),
+       "no epoch line in the 1000 lines after the header: not RINEX 3.04 observation data",
+       4 + RinexObsReader::kMaxLinesBeforeFirstEpoch},
+      {"rinex2_body_in_rinex3_file", header_v3() + good_epoch(false, 0) + good_epoch(false, 1),
+       "1 of the 1 epochs are corrupt; the first: expected an epoch line starting with '>'", 5},
+      {"event_epoch_with_bad_types",
+       header_v3() + valid + epoch_v3(2021, 9, 22, 6, 30, 1.0, 4, 1) + header_line("G    x", "SYS / # / OBS TYPES"),
+       "bad number of observation types", 8},
   };
 }
 

@@ -302,36 +302,6 @@ void gzip_file(const std::string& from, const std::string& to) {
   ASSERT_EQ(gzclose(out), Z_OK);
 }
 
-void expect_same_epochs(const RinexObsFile& a, const RinexObsFile& b, double tolerance) {
-  ASSERT_EQ(a.epochs.size(), b.epochs.size());
-  for (std::size_t i = 0; i < a.epochs.size(); ++i) {
-    const auto& ea = a.epochs[i];
-    const auto& eb = b.epochs[i];
-    ASSERT_NEAR(ea.time - eb.time, 0.0, 1e-7) << "epoch " << i;
-    ASSERT_EQ(ea.flag, eb.flag);
-    ASSERT_EQ(ea.sats.size(), eb.sats.size()) << "epoch " << i;
-    for (std::size_t k = 0; k < ea.sats.size(); ++k) {
-      const auto& sa = ea.sats[k];
-      const auto& sb = eb.sats[k];
-      ASSERT_EQ(sa.sat, sb.sat);
-      ASSERT_EQ(sa.signals.size(), sb.signals.size()) << sa.sat.to_string() << " epoch " << i;
-      for (const auto& x : sa.signals) {
-        const core::SignalObs* y = sb.find(x.code);
-        ASSERT_NE(y, nullptr) << sa.sat.to_string() << " " << x.code.to_string();
-        const auto near = [&](double u, double v) {
-          return (!core::has_value(u) && !core::has_value(v)) || std::abs(u - v) <= tolerance;
-        };
-        EXPECT_TRUE(near(x.pseudorange_m, y->pseudorange_m)) << x.pseudorange_m << " " << y->pseudorange_m;
-        EXPECT_TRUE(near(x.carrier_phase_cyc, y->carrier_phase_cyc))
-            << x.carrier_phase_cyc << " " << y->carrier_phase_cyc;
-        EXPECT_TRUE(near(x.doppler_hz, y->doppler_hz));
-        EXPECT_TRUE(near(x.snr_dbhz, y->snr_dbhz));
-        EXPECT_EQ(x.lli, y->lli);
-      }
-    }
-  }
-}
-
 TEST(RinexObservationSharedData, GzipFileGivesTheSameEpochs) {
   SKIP_WITHOUT_SHARED_DATA();
   test::TempDir tmp;
@@ -342,25 +312,45 @@ TEST(RinexObservationSharedData, GzipFileGivesTheSameEpochs) {
     gzip_file(plain, gz);
     const RinexObsFile a = read_ok(plain);
     const RinexObsFile b = read_ok(gz);
-    expect_same_epochs(a, b, 0.0);
+    test::expect_same_epochs(a.epochs, b.epochs, 0.0);
   }
 }
 
-TEST(RinexObservationSharedData, TruncatedGzipIsAnError) {
+TEST(RinexObservationSharedData, TruncatedGzipKeepsTheEpochsBeforeTheCut) {
   SKIP_WITHOUT_SHARED_DATA();
   test::TempDir tmp;
+  const std::string plain = kData + "/cssrlib-kinematic-doy265/SEPT265G.21O";
+  const RinexObsFile full = read_ok(plain);
   const std::string gz = tmp.file("full.obs.gz");
-  gzip_file(kData + "/cssrlib-kinematic-doy265/SEPT265G.21O", gz);
+  gzip_file(plain, gz);
   std::ifstream in(gz, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const double fraction : {0.1, 0.5, 0.9, 0.999}) {
     SCOPED_TRACE(fraction);
     const std::string cut = tmp.write("cut.obs.gz", bytes.substr(0, static_cast<std::size_t>(bytes.size() * fraction)));
-    const auto file = read_rinex_obs(cut);
-    ASSERT_FALSE(file.ok());
-    EXPECT_EQ(file.error().file, cut);
-    EXPECT_GT(file.error().line, 0);
+    const RinexObsFile file = read_ok(cut);
+    // Every complete epoch before the cut, unchanged; the one the cut falls in is dropped with a warning that says
+    // where and why.
+    ASSERT_LT(file.epochs.size(), full.epochs.size());
+    EXPECT_GT(file.epochs.size(), static_cast<std::size_t>(full.epochs.size() * fraction * 0.5));
+    const std::vector<core::ObsEpoch> before(full.epochs.begin(),
+                                             full.epochs.begin() + static_cast<std::ptrdiff_t>(file.epochs.size()));
+    test::expect_same_epochs(file.epochs, before, 0.0);
+    ASSERT_EQ(file.warnings.size(), 1u);
+    const std::string& warning = file.warnings[0];
+    EXPECT_EQ(warning.rfind(cut + ":", 0), 0u) << warning;
+    EXPECT_NE(warning.find("file ends inside an epoch"), std::string::npos) << warning;
+    EXPECT_NE(warning.find("(read error: "), std::string::npos) << warning;
+    EXPECT_NE(warning.find("epoch skipped (lines "), std::string::npos) << warning;
   }
+  // Cut inside the header: nothing can be read, an Error.
+  const std::string header_cut = tmp.write("header_cut.obs.gz", bytes.substr(0, 200));
+  const auto file = read_rinex_obs(header_cut);
+  ASSERT_FALSE(file.ok());
+  EXPECT_EQ(file.error().file, header_cut);
+  EXPECT_GT(file.error().line, 0);
+  EXPECT_NE(file.error().message.find("the file ends inside the header (read error: "), std::string::npos)
+      << file.error().to_string();
 }
 
 // ----- writer round trips
@@ -375,7 +365,7 @@ void expect_round_trip(const std::string& path) {
   const RinexObsFile again = read_ok(out);
   EXPECT_DOUBLE_EQ(again.header.version, 3.04);
   EXPECT_TRUE(again.warnings.empty());
-  expect_same_epochs(original, again, kMaxRoundTripErrorM);
+  test::expect_same_epochs(original.epochs, again.epochs, kMaxRoundTripErrorM);
   for (std::size_t i = 0; i < original.epochs.size(); ++i) {
     const double a = original.epochs[i].receiver_clock_offset_s;
     const double b = again.epochs[i].receiver_clock_offset_s;

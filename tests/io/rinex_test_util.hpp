@@ -1,14 +1,19 @@
 #pragma once
-// Helpers for the RINEX tests: a per-test temporary folder and builders for fixed-column RINEX text.
+// Helpers for the RINEX tests: a per-test temporary folder, builders for fixed-column RINEX text, and a comparison
+// of epoch sequences.
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
+
+#include "canyon/core/observation.hpp"
 
 namespace canyon::io::test {
 
@@ -71,6 +76,38 @@ inline std::string epoch_v2(int year, int month, int day, int hour, int minute, 
   std::snprintf(text, sizeof text, " %02d %2d %2d %2d %2d%11.7f  %d%3d", year % 100, month, day, hour, minute, second,
                 flag, count);
   return text;
+}
+
+/// Same epochs: times, flags, satellites and signals, values within `tolerance` (missing in both counts as equal).
+inline void expect_same_epochs(const std::vector<core::ObsEpoch>& a, const std::vector<core::ObsEpoch>& b,
+                               double tolerance) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto& ea = a[i];
+    const auto& eb = b[i];
+    ASSERT_NEAR(ea.time - eb.time, 0.0, 1e-7) << "epoch " << i;
+    ASSERT_EQ(ea.flag, eb.flag);
+    ASSERT_EQ(ea.sats.size(), eb.sats.size()) << "epoch " << i;
+    for (std::size_t k = 0; k < ea.sats.size(); ++k) {
+      const auto& sa = ea.sats[k];
+      const auto& sb = eb.sats[k];
+      ASSERT_EQ(sa.sat, sb.sat);
+      ASSERT_EQ(sa.signals.size(), sb.signals.size()) << sa.sat.to_string() << " epoch " << i;
+      for (const auto& x : sa.signals) {
+        const core::SignalObs* y = sb.find(x.code);
+        ASSERT_NE(y, nullptr) << sa.sat.to_string() << " " << x.code.to_string();
+        const auto near = [&](double u, double v) {
+          return (!core::has_value(u) && !core::has_value(v)) || std::abs(u - v) <= tolerance;
+        };
+        EXPECT_TRUE(near(x.pseudorange_m, y->pseudorange_m)) << x.pseudorange_m << " " << y->pseudorange_m;
+        EXPECT_TRUE(near(x.carrier_phase_cyc, y->carrier_phase_cyc))
+            << x.carrier_phase_cyc << " " << y->carrier_phase_cyc;
+        EXPECT_TRUE(near(x.doppler_hz, y->doppler_hz));
+        EXPECT_TRUE(near(x.snr_dbhz, y->snr_dbhz));
+        EXPECT_EQ(x.lli, y->lli);
+      }
+    }
+  }
 }
 
 }  // namespace canyon::io::test

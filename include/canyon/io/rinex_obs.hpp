@@ -54,9 +54,42 @@ class RinexObsReader {
   [[nodiscard]] const RinexObsHeader& header() const { return header_; }
 
   /// Next observation epoch (flags 0, 1, 6; header records of flags 2-5 are read and skipped), nullopt at the end.
-  /// Error (file and line) on a malformed epoch that cannot be recovered. Recoverable defects (an epoch that
-  /// announces more satellites than it holds, an unknown satellite system) are skipped with a warning.
+  ///
+  /// Once the header has been read, a defect in the body costs at most the epoch it is in: it becomes a warning
+  /// "file:line: what, ..." (see warnings()) and reading goes on.
+  /// - A corrupt epoch (garbled epoch line, unparseable or cut-short observation value, bad satellite id, RINEX 2
+  ///   satellite list shorter than its count, lines where an epoch line should be) is skipped: "file:line: what,
+  ///   epoch skipped (lines a-b)", or "N epochs skipped" when the lines skipped hold further garbled RINEX 3 epoch
+  ///   lines. Reading resumes at the next line that parses as an epoch line (RINEX 3: a line starting with '>'
+  ///   whose fields parse; RINEX 2: a line whose epoch fields parse with a valid date from 1980, flag 0-6 and
+  ///   satellite count 0-999, and whose satellite list slots hold satellite ids). The line where the defect
+  ///   showed is itself examined, so an epoch announcing more records than it holds does not swallow the next one.
+  /// - A RINEX 3 epoch with fewer satellite records than announced is kept with what it has (the next '>' line
+  ///   ends it); one with more keeps the announced ones and the lines after are skipped as above. A RINEX 2 epoch
+  ///   with fewer records than listed satellites is skipped (the list does not say which one has no record).
+  /// - End of input inside an epoch (a truncated file, a truncated gzip stream): that last partial epoch is skipped
+  ///   with a warning that says so, with the read error if there is one; every epoch before is returned. An epoch
+  ///   whose last line is the unterminated tail that a read error left is skipped too.
+  /// - An epoch (flag 0 or 1) whose time is not after the previous epoch's (duplicate, or time going backwards) is
+  ///   skipped: later stages assume increasing time. A flag 6 epoch (cycle slip records) may repeat the time. A
+  ///   corrupt time that still parses as a valid later one cannot be told from a true one: the epochs up to it are
+  ///   then skipped as out of order, each with its warning.
+  /// - Records of systems canyon does not process, of satellite numbers out of range, or of a system without
+  ///   observation types in the header are skipped, one warning per system or satellite.
+  /// Error (file and line) only when the body as a whole is not usable observation data, or the data after a point
+  /// cannot be interpreted:
+  /// - no line of the first kMaxLinesBeforeFirstEpoch after the header parses as an epoch line (garbage, or not
+  ///   this RINEX version's layout): as soon as that is clear;
+  /// - at the end of the input, more corrupt epochs than valid ones, a body of corrupt epochs only included (after
+  ///   the valid epochs have been returned: read_rinex_obs() then returns the Error);
+  /// - a header record of an event epoch (flag 4) that cannot be parsed, as in the file header.
+  /// Reading always advances: each call consumes at least one line, or reports the end.
   Result<std::optional<core::ObsEpoch>> next();
+
+  /// A body that holds no line parsing as an epoch line within this many lines after the header is an Error: more
+  /// than the longest real epoch (RINEX 2: up to 4 lines per satellite, 100+ satellites), so one corrupt first
+  /// epoch is still skipped and read past.
+  static constexpr int kMaxLinesBeforeFirstEpoch = 1000;
 
   /// Warnings about recovered defects so far, "file:line: what" each.
   [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
@@ -77,10 +110,25 @@ class RinexObsReader {
   void build_mapping();
   /// Reads the `count` header records following an event epoch line (flags 2-5).
   Status skip_event_records(int count);
+  /// Whether `line` can start an epoch: the resynchronisation test (see next()).
+  [[nodiscard]] bool is_epoch_line(std::string_view line) const;
+  /// The satellite records of an epoch whose epoch line `line` (at `epoch_line`) parsed into `count` satellites.
+  Status read_records(core::ObsEpoch& epoch, std::string_view line, int count, int epoch_line);
   /// Satellite list of a RINEX 2 epoch (continuation lines included) into sat_tokens_.
   Status read_sat_list_v2(std::string_view epoch_line, int count);
   Status read_satellites_v3(core::ObsEpoch& epoch, int count, int epoch_line);
   Status read_satellites_v2(core::ObsEpoch& epoch);
+  /// Skips the corrupt epoch that starts at `first_line`, `problem` saying what is wrong: reads up to the next epoch
+  /// line (left unread) and warns. Error if the body shows no epoch line in its first kMaxLinesBeforeFirstEpoch.
+  Status skip_corrupt_epoch(const Error& problem, int first_line);
+  /// Reads up to the next line that is_epoch_line() and leaves it unread (or to the end of the input). The number
+  /// of garbled epoch lines (RINEX 3: starting with '>') read past, or an Error as skip_corrupt_epoch() says.
+  Result<int> resynchronise();
+  /// Whether `epoch` (of `epoch_line`) comes after the previous one; warns about it if not.
+  bool in_time_order(const core::ObsEpoch& epoch, const core::CalendarTime& time, int epoch_line);
+  /// End of the input: nullopt, with a warning about a read error not reported yet; Error if more epochs were
+  /// corrupt than valid.
+  Result<std::optional<core::ObsEpoch>> end_of_body();
   /// Satellite of a record: its id, nullopt for a record to skip (warned), or an Error.
   Result<std::optional<core::SatelliteId>> resolve_satellite(std::string_view token);
   /// Parses `count` observation fields of 16 columns from column `first_col` of `line` into scratch_.
@@ -90,8 +138,8 @@ class RinexObsReader {
   void emit_satellite(core::SatelliteId sat, core::ObsEpoch& epoch);
   [[nodiscard]] core::GpsTime to_gps(const core::CalendarTime& c) const;
   void warn(int line, const std::string& message);
-  /// Error at end of input: the read error (truncated gzip) if there is one, else `message`.
-  [[nodiscard]] Error end_of_input_error(const std::string& message) const;
+  /// Error at end of input: `message`, with the read error (truncated gzip) if there is one.
+  [[nodiscard]] Error end_of_input_error(const std::string& message);
 
   TextReader reader_;
   RinexObsHeader header_;
@@ -118,6 +166,15 @@ class RinexObsReader {
   };
   std::vector<ScaleFactor> scale_factors_;  // "SYS / SCALE FACTOR"
   ScaleFactor continued_scale_;             // system and factor a continuation line refers to
+  // Body state for recovery.
+  int header_end_line_ = 0;                 // line of END OF HEADER
+  bool epoch_line_seen_ = false;            // a line of the body has parsed as an epoch line
+  int valid_epochs_ = 0;                    // epochs returned
+  int corrupt_epochs_ = 0;                  // epochs skipped as corrupt (not those out of time order)
+  Error first_corruption_;                  // warning of the first corrupt epoch, for the end-of-body Error
+  std::optional<core::GpsTime> last_time_;  // of the last flag 0 or 1 epoch returned
+  int last_time_line_ = 0;                  // its epoch line
+  bool read_error_reported_ = false;        // the read error is in a warning already
 };
 
 /// A whole file in memory.
@@ -126,6 +183,7 @@ struct RinexObsFile {
   std::vector<core::ObsEpoch> epochs;
   std::vector<std::string> warnings;
 };
+/// Every epoch of the file and the reader's warnings; an Error when open() or next() gives one.
 Result<RinexObsFile> read_rinex_obs(const std::string& path);
 
 /// Writes RINEX 3.04 observations. Observation types per system are taken from `header.obs_types` if given,

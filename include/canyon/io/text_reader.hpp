@@ -30,6 +30,11 @@ class TextReader {
   [[nodiscard]] const std::string& path() const { return path_; }
   /// Read error, if reading stopped because of one rather than at the end of the file.
   [[nodiscard]] const std::optional<std::string>& read_error() const { return read_error_; }
+  /// Whether next_line() has returned nullopt: nothing more to read (see read_error() for why).
+  [[nodiscard]] bool ended() const { return ended_; }
+  /// Whether the last line consumed (returned and not pushed back) is the unterminated tail that a read error left
+  /// behind: a line cut short, e.g. by a truncated gzip stream.
+  [[nodiscard]] bool line_cut() const { return line_cut_ && !pushed_back_; }
   /// Error at the current line.
   [[nodiscard]] Error error(std::string message) const { return Error{std::move(message), path_, line_number_}; }
 
@@ -45,6 +50,8 @@ class TextReader {
   std::string line_;
   bool pushed_back_ = false;
   bool eof_ = false;
+  bool ended_ = false;
+  bool line_cut_ = false;
   int line_number_ = 0;
   std::optional<std::string> read_error_;
 };
