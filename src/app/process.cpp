@@ -2,6 +2,7 @@
 
 #include "canyon/app/process.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -17,6 +18,32 @@ namespace canyon::app {
 namespace {
 
 constexpr std::size_t kMaxEpochNotes = 100;
+
+/// The epochs of an observation file as observations: flag 6 epochs hold cycle-slip records (slip counts in the
+/// observation fields), not observations, and are dropped; after a power failure (flag 1) every phase may have
+/// slipped and gets the loss-of-lock bit. One warning per file for each.
+void keep_observations(io::RinexObsFile& file, const std::string& path, std::vector<std::string>& warnings) {
+  const auto slip_records = std::count_if(file.epochs.begin(), file.epochs.end(), [](const core::ObsEpoch& e) {
+    return e.flag == core::EpochFlag::CycleSlipRecords;
+  });
+  if (slip_records > 0) {
+    std::erase_if(file.epochs, [](const core::ObsEpoch& e) { return e.flag == core::EpochFlag::CycleSlipRecords; });
+    warnings.push_back(path + ": " + std::to_string(slip_records) +
+                       " epochs of cycle-slip records (flag 6) are not observations, not used");
+  }
+  int power_failures = 0;
+  for (core::ObsEpoch& epoch : file.epochs) {
+    if (epoch.flag != core::EpochFlag::PowerFailure) continue;
+    ++power_failures;
+    for (core::SatelliteObs& sat : epoch.sats) {
+      for (core::SignalObs& signal : sat.signals) signal.lli |= core::kLliLossOfLock;
+    }
+  }
+  if (power_failures > 0) {
+    warnings.push_back(path + ": " + std::to_string(power_failures) +
+                       " epochs after a power failure (flag 1): all their phases taken as lost lock");
+  }
+}
 
 Result<core::NavigationData> read_navigation(const std::vector<std::string>& paths,
                                              std::vector<std::string>& warnings) {
@@ -182,6 +209,7 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
   auto rover = io::read_rinex_obs(config.rover_obs);
   if (!rover) return rover.error();
   summary.warnings.insert(summary.warnings.end(), rover->warnings.begin(), rover->warnings.end());
+  keep_observations(*rover, config.rover_obs, summary.warnings);
 
   std::optional<io::RinexObsFile> base;
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
@@ -189,6 +217,7 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
     auto base_file = io::read_rinex_obs(config.base_obs);
     if (!base_file) return base_file.error();
     summary.warnings.insert(summary.warnings.end(), base_file->warnings.begin(), base_file->warnings.end());
+    keep_observations(*base_file, config.base_obs, summary.warnings);
     if (config.base_position_E_m) {
       p_E_base = *config.base_position_E_m;
     } else if (base_file->header.receiver.approx_position_E_m) {

@@ -485,3 +485,56 @@ TEST(RtkEpochMatching, FiveMillisecondClockOffsetAndLowerRateBase) {
 
 }  // namespace
 }  // namespace canyon
+
+namespace canyon {
+namespace {
+
+/// RINEX epoch flags: cycle-slip records (flag 6) are not observations and change nothing; a power failure (flag 1)
+/// marks every phase as lost lock (the ambiguities restart, so the epoch is not fixed from the old ones).
+TEST(RtkEpochFlags, CycleSlipRecordsAreNotObservationsAndPowerFailureResetsLock) {
+  REQUIRE_DATA("cssrlib-static-doy078");
+  const fs::path tmp = test::temp_dir("rtk-flags");
+  auto rover = io::read_rinex_obs((shared_data() / "cssrlib-static-doy078/SEPT078M1.21O").string());
+  ASSERT_TRUE(rover.ok());
+  std::vector<core::ObsEpoch> with_slip_records;
+  for (std::size_t i = 0; i < rover->epochs.size(); ++i) {
+    with_slip_records.push_back(rover->epochs[i]);
+    if (i == 20) {
+      core::ObsEpoch records = rover->epochs[i];  // same time, "slip counts" in the observation fields
+      records.flag = core::EpochFlag::CycleSlipRecords;
+      for (core::SatelliteObs& sat : records.sats) {
+        for (core::SignalObs& s : sat.signals) s.pseudorange_m = s.carrier_phase_cyc = 1.0;
+      }
+      with_slip_records.push_back(records);
+    }
+  }
+  const fs::path slip_path = tmp / "rover-flag6.obs";
+  ASSERT_TRUE(io::write_rinex_obs(slip_path.string(), rover->header, with_slip_records).ok());
+  const Eigen::Vector3d base(-3959400.631, 3385704.533, 3667523.111);
+  const auto run = [&](const std::string& path) {
+    return run_rtk("flags", path, "cssrlib-static-doy078/3034078M1.21O", {"cssrlib-static-doy078/SEPT078M.21P"}, base);
+  };
+  auto plain = run("cssrlib-static-doy078/SEPT078M1.21O");
+  auto slips = run(slip_path.string());
+  ASSERT_TRUE(plain.has_value() && slips.has_value());
+  ASSERT_EQ(plain->solutions.size(), slips->solutions.size());
+  for (std::size_t i = 0; i < plain->solutions.size(); ++i) {
+    EXPECT_LT((plain->solutions[i].p_E_m - slips->solutions[i].p_E_m).norm(), 1e-4) << i;
+  }
+  EXPECT_TRUE(std::any_of(slips->summary.warnings.begin(), slips->summary.warnings.end(),
+                          [](const std::string& w) { return w.find("flag 6") != std::string::npos; }));
+
+  rover->epochs[30].flag = core::EpochFlag::PowerFailure;
+  const fs::path power_path = tmp / "rover-flag1.obs";
+  ASSERT_TRUE(io::write_rinex_obs(power_path.string(), rover->header, rover->epochs).ok());
+  auto power = run_rtk("flags", power_path.string(), "cssrlib-static-doy078/3034078M1.21O",
+                       {"cssrlib-static-doy078/SEPT078M.21P"}, base,
+                       [](app::ProcessConfig& c) { c.rtk.ar_mode = rtk::ArMode::Continuous; });
+  ASSERT_TRUE(power.has_value());
+  EXPECT_TRUE(std::any_of(power->summary.warnings.begin(), power->summary.warnings.end(),
+                          [](const std::string& w) { return w.find("power failure") != std::string::npos; }));
+  EXPECT_EQ(power->summary.epochs, 60);
+}
+
+}  // namespace
+}  // namespace canyon
