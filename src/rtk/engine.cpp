@@ -562,6 +562,19 @@ std::optional<RtkEngine::Fix> RtkEngine::prune(Fix fix, int min_size) const {
   return std::nullopt;
 }
 
+std::optional<RtkEngine::Fix> RtkEngine::last_subset_fix(const std::vector<std::pair<int, int>>& all,
+                                                         int min_size) const {
+  if (last_fix_.empty()) return std::nullopt;
+  std::vector<std::pair<int, int>> dd;
+  for (const auto& pair : all) {
+    if (last_fix_.count(dd_key(pair)) != 0) dd.push_back(pair);
+  }
+  if (dd.size() == all.size()) return std::nullopt;  // the full set, tried already
+  auto fix = try_fix(dd, min_size);
+  if (fix && accepted(*fix)) return fix;
+  return std::nullopt;
+}
+
 bool RtkEngine::better_fix(const Fix& l, const Fix& r) {
   return l.a_fix.size() > r.a_fix.size() || (l.a_fix.size() == r.a_fix.size() && l.ratio > r.ratio);
 }
@@ -571,7 +584,9 @@ std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDif
   // First prune satellites from the full set. Then leave out whole groups or constellations (signals that the two
   // receivers track differently bias a whole group): the accepted subset with the most ambiguities, or else the
   // best of pruning the kPrunedSubsets subsets closest to passing (highest ratio). At most
-  // 1 + (1 + kPrunedSubsets) max_pruned_satellites + (number of exclusions) integer searches per epoch.
+  // 2 + (1 + kPrunedSubsets) max_pruned_satellites + (number of exclusions) integer searches per epoch. Before all
+  // that, the subset of the last fix still tracked: in continuous mode it usually passes again (one search).
+  if (auto again = last_subset_fix(dd_ambiguities(sds, Exclusion{}), min_size)) return again;
   if (full) {
     if (auto pruned = prune(std::move(*full), min_size)) return pruned;
   }

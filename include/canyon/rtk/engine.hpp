@@ -178,6 +178,8 @@ class RtkEngine {
   [[nodiscard]] core::SatelliteId satellite_of_state(int index) const;
   [[nodiscard]] core::SatelliteId satellite_of_largest_contribution(const std::vector<std::pair<int, int>>& dd,
                                                                     const Eigen::VectorXd& contributions) const;
+  /// The DD ambiguities of `all` that the last fix fixed, if they are fewer than `all` and their fix is accepted.
+  [[nodiscard]] std::optional<Fix> last_subset_fix(const std::vector<std::pair<int, int>>& all, int min_size) const;
   /// More ambiguities, then the higher ratio.
   [[nodiscard]] static bool better_fix(const Fix& l, const Fix& r);
   /// Partial fixing after the full set failed: pruning, then without each group or constellation.
