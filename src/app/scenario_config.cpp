@@ -484,7 +484,9 @@ Result<Scenario> parse_scenario(const YAML::Node& node, const std::string& file)
   top.reject_unknown_keys();
   if (Status st = top.status(); !st) return st.error();
   if (const std::string e = s.validate(); !e.empty()) {
-    return Error{e, file, line_of_path(node, e.substr(0, e.find(' ')))};
+    std::string key = e.substr(0, e.find(' '));
+    if (!key.empty() && key.back() == ':') key.pop_back();
+    return Error{e, file, line_of_path(node, key)};
   }
   return s;
 }

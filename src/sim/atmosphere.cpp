@@ -78,7 +78,14 @@ double Troposphere::residual_zwd_m(double t_s, bool base) const {
 
 double Troposphere::slant_delay_m(double t_s, const core::Geodetic& rcv, double elevation_rad, bool base) const {
   if (elevation_rad <= 0.0) return 0.0;
-  return gnss::saastamoinen_delay_m(rcv, elevation_rad) + residual_zwd_m(t_s, base) * wet_mapping(elevation_rad);
+  // Saastamoinen's 1 / cos(z) diverges at the horizon: below 15 deg it is continued with the ratio of the Black and
+  // Eisner mapping function 1.001 / sqrt(0.002001 + sin^2 el), which stays finite (about 22 at 0 deg).
+  constexpr double kBlendRad = 15.0 * core::kPi / 180.0;
+  const auto black_eisner = [](double el) { return 1.001 / std::sqrt(0.002001 + std::sin(el) * std::sin(el)); };
+  const double model_m = elevation_rad >= kBlendRad ? gnss::saastamoinen_delay_m(rcv, elevation_rad)
+                                                    : gnss::saastamoinen_delay_m(rcv, kBlendRad) *
+                                                          black_eisner(elevation_rad) / black_eisner(kBlendRad);
+  return model_m + residual_zwd_m(t_s, base) * wet_mapping(elevation_rad);
 }
 
 }  // namespace canyon::sim

@@ -11,8 +11,9 @@
 // is 40.3e16 VTEC F / f^2 metres with the thin-shell mapping F = 1 / sqrt(1 - (R cos(el) / (R + h))^2): a group
 // delay on the code, an advance of the carrier phase.
 //
-// Troposphere: Saastamoinen with the standard atmosphere (the model RTKLIB and canyon apply) plus a residual zenith
-// wet delay mapped with Chao's wet mapping function 1 / (sin el + 0.00035 / (tan el + 0.017)). The residual is
+// Troposphere: Saastamoinen with the standard atmosphere (the model RTKLIB and canyon apply; below 15 deg, where its
+// 1 / cos(z) diverges, continued with the Black and Eisner mapping function) plus a residual zenith wet delay mapped
+// with Chao's wet mapping function 1 / (sin el + 0.00035 / (tan el + 0.017)). The residual is
 // zwd_residual_m at the rover, zwd_residual_m + zwd_difference_m at the base, each varying by zwd_variation_m with
 // periods of 1 to 2 hours.
 

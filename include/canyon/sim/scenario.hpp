@@ -154,7 +154,7 @@ struct VioOptions {
 struct Scenario {
   std::string name = "custom";
   std::uint64_t seed = 1;  ///< random seed (the command line's --seed overrides it)
-  core::GpsTime start = core::calendar_to_gps({2023, 6, 14, 18, 0, 0.0});  ///< first epoch (GPST)
+  core::GpsTime start = core::calendar_to_gps({2023, 6, 14, 16, 0, 0.0});  ///< first epoch (GPST)
   double duration_s = 600.0;                                               ///< (s)
   double rover_rate_hz = 5.0;                                              ///< rover observation rate (Hz)
   core::Geodetic origin{47.6062 * 0.017453292519943295, -122.3321 * 0.017453292519943295, 20.0};  ///< city origin
