@@ -32,6 +32,7 @@ std::string resolve(const std::string& path, const std::string& file) {
 
 void parse_signals(YamlMap& map, const std::string& key, std::vector<core::SignalCode>& out) {
   std::vector<std::string> texts;
+  texts.reserve(out.size());
   for (const core::SignalCode s : out) texts.push_back(s.to_string());
   map.get(key, texts);
   std::vector<core::SignalCode> signals;
@@ -302,6 +303,7 @@ std::string list(const std::vector<std::string>& items) {
 
 std::string signal_list(const std::vector<core::SignalCode>& signals) {
   std::vector<std::string> items;
+  items.reserve(signals.size());
   for (const core::SignalCode s : signals) items.push_back(s.to_string());
   return list(items);
 }
@@ -445,7 +447,7 @@ std::vector<fs::path> scenario_folders() {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) folders.push_back(exe.parent_path() / ".." / "config" / "scenarios");
-  if (std::string(CANYON_SCENARIO_DIR).size() > 0) folders.emplace_back(CANYON_SCENARIO_DIR);
+  if (!std::string(CANYON_SCENARIO_DIR).empty()) folders.emplace_back(CANYON_SCENARIO_DIR);
   return folders;
 }
 

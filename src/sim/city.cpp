@@ -77,7 +77,7 @@ CityExtent blocks_extent(const std::vector<int>& blocks, const StreetGrid& grid)
   return e;
 }
 
-City::City(StreetGrid grid, CityExtent extent, std::vector<Building> buildings, std::vector<Tree> trees)
+City::City(const StreetGrid& grid, const CityExtent& extent, std::vector<Building> buildings, std::vector<Tree> trees)
     : grid_(grid), extent_(extent), buildings_(std::move(buildings)), trees_(std::move(trees)) {
   for (int b = 0; b < static_cast<int>(buildings_.size()); ++b) {
     const Building& building = buildings_[static_cast<std::size_t>(b)];
@@ -369,20 +369,20 @@ City generate_city(const CityOptions& city, const TreeOptions& trees, const City
     // Along the avenues (streets at y = j pitch_y), both sides, block frontage only.
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i < i1; ++i) {
-        for (double x = i * grid.pitch_x_m + half_w + trees.spacing_m / 2.0; x < (i + 1) * grid.pitch_x_m - half_w;
-             x += trees.spacing_m) {
-          plant({x, j * grid.pitch_y_m - offset});
-          plant({x, j * grid.pitch_y_m + offset});
+        const double x0 = i * grid.pitch_x_m + half_w + trees.spacing_m / 2.0;
+        for (int k = 0; x0 + k * trees.spacing_m < (i + 1) * grid.pitch_x_m - half_w; ++k) {
+          plant({x0 + k * trees.spacing_m, j * grid.pitch_y_m - offset});
+          plant({x0 + k * trees.spacing_m, j * grid.pitch_y_m + offset});
         }
       }
     }
     // Along the cross streets (x = i pitch_x).
     for (int i = i0; i <= i1; ++i) {
       for (int j = j0; j < j1; ++j) {
-        for (double y = j * grid.pitch_y_m + half_w + trees.spacing_m / 2.0; y < (j + 1) * grid.pitch_y_m - half_w;
-             y += trees.spacing_m) {
-          plant({i * grid.pitch_x_m - offset, y});
-          plant({i * grid.pitch_x_m + offset, y});
+        const double y0 = j * grid.pitch_y_m + half_w + trees.spacing_m / 2.0;
+        for (int k = 0; y0 + k * trees.spacing_m < (j + 1) * grid.pitch_y_m - half_w; ++k) {
+          plant({i * grid.pitch_x_m - offset, y0 + k * trees.spacing_m});
+          plant({i * grid.pitch_x_m + offset, y0 + k * trees.spacing_m});
         }
       }
     }

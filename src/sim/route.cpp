@@ -150,17 +150,17 @@ std::vector<Eigen::Vector2d> random_walk_G(const RouteOptions& route, const Stre
   const auto node = [&](std::size_t k) { return Eigen::Vector2d(nodes[k].cast<double>().cwiseProduct(pitch)); };
   std::vector<Eigen::Vector2d> points;
   if (moves.empty()) return {node(0), node(0) + Eigen::Vector2d(1.0, 0.0)};
-  points.push_back(node(0) + offset * right_of(moves.front()));
+  points.emplace_back(node(0) + offset * right_of(moves.front()));
   for (std::size_t k = 1; k < moves.size(); ++k) {
     if (moves[k] == moves[k - 1]) continue;
     if (moves[k] == (moves[k - 1] + 2) % 4) {  // turning back: cross the street
-      points.push_back(node(k) + offset * right_of(moves[k - 1]));
-      points.push_back(node(k) + offset * right_of(moves[k]));
+      points.emplace_back(node(k) + offset * right_of(moves[k - 1]));
+      points.emplace_back(node(k) + offset * right_of(moves[k]));
     } else {
-      points.push_back(node(k) + offset * (right_of(moves[k - 1]) + right_of(moves[k])));
+      points.emplace_back(node(k) + offset * (right_of(moves[k - 1]) + right_of(moves[k])));
     }
   }
-  points.push_back(node(moves.size()) + offset * right_of(moves.back()));
+  points.emplace_back(node(moves.size()) + offset * right_of(moves.back()));
   return points;
 }
 

@@ -510,6 +510,7 @@ Result<Ground> build_ground(const Scenario& sc) {
   }
   City city = generate_city(sc.city, sc.trees, extent, sc.seed);
   std::vector<Eigen::Vector2d> points_N;
+  points_N.reserve(points_G.size());
   for (const Eigen::Vector2d& p : points_G) points_N.push_back(grid.to_N(p));
   for (std::size_t k = 1; k < points_N.size(); ++k) {
     if ((points_N[k] - points_N[k - 1]).norm() < 1e-3) {
@@ -518,9 +519,10 @@ Result<Ground> build_ground(const Scenario& sc) {
   }
   Path path = Path::through(points_N, sc.route.turn_radius_m);
   // The walk must stay in the streets: sample it every 0.5 m.
-  for (double s = 0.0; s <= path.length_m(); s += 0.5) {
-    if (city.inside_building(path.position_N(s))) {
-      const Eigen::Vector2d p = path.position_N(s);
+  constexpr double kRouteCheckStepM = 0.5;
+  for (int k = 0; k * kRouteCheckStepM <= path.length_m(); ++k) {
+    const Eigen::Vector2d p = path.position_N(k * kRouteCheckStepM);
+    if (city.inside_building(p)) {
       return scenario_error(sc, "the route enters a building at (east " + std::to_string(std::lround(p.x())) +
                                     " m, north " + std::to_string(std::lround(p.y())) +
                                     " m): route.waypoints_m must follow the streets");

@@ -48,7 +48,7 @@ TEST(RngTest, IntegersCoverTheInclusiveRangeEvenly) {
     ASSERT_LE(k, 3);
     ++counts[static_cast<std::size_t>(k + 3)];
   }
-  for (const int c : counts) EXPECT_NEAR(c, kSamples / 7, 5.0 * std::sqrt(kSamples / 7.0));
+  for (const int c : counts) EXPECT_NEAR(c, kSamples / 7.0, 5.0 * std::sqrt(kSamples / 7.0));
   EXPECT_EQ(rng.integer(5, 5), 5);
 }
 

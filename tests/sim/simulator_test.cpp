@@ -260,8 +260,7 @@ TEST(SimulatorTest, LineOfSightPhaseIsIntegerWithTheFullErrorModel) {
     if (b == base_at.end()) continue;
     const std::size_t base_index = static_cast<std::size_t>(&*b->second - g.sim.base.truth.data());
     std::map<std::pair<Constellation, core::SignalCode>, std::vector<double>> sd;  // single differences
-    for (std::size_t i = 0; i < rt.signals.size(); ++i) {
-      const SignalTruth& t = rt.signals[i];
+    for (const SignalTruth& t : rt.signals) {
       if (!t.direct || t.sat.system == Constellation::Glonass) continue;
       const SignalTruth* tb = nullptr;
       for (const SignalTruth& x : b->second->signals) {
@@ -276,7 +275,8 @@ TEST(SimulatorTest, LineOfSightPhaseIsIntegerWithTheFullErrorModel) {
       for (const auto& s : g.sim.base.epochs[base_index].sats) {
         if (s.sat == t.sat) obs_b = s.find(t.code);
       }
-      ASSERT_TRUE(obs_r != nullptr && obs_b != nullptr);
+      ASSERT_NE(obs_r, nullptr);
+      ASSERT_NE(obs_b, nullptr);
       sd[{t.sat.system, t.code}].push_back(model_residual(t, *obs_r) - model_residual(*tb, *obs_b));
     }
     for (const auto& [group, values] : sd) {

@@ -82,7 +82,7 @@ struct WallReflection {
 class City {
  public:
   City() = default;
-  City(StreetGrid grid, CityExtent extent, std::vector<Building> buildings, std::vector<Tree> trees);
+  City(const StreetGrid& grid, const CityExtent& extent, std::vector<Building> buildings, std::vector<Tree> trees);
 
   /// True if a building blocks the ray from `p_N` towards direction `u_N` (unit; satellite at infinity).
   [[nodiscard]] bool direct_blocked(const Eigen::Vector3d& p_N, const Eigen::Vector3d& u_N) const;
