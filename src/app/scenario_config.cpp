@@ -233,8 +233,16 @@ void parse_orbit_errors(YamlMap map, sim::OrbitErrorOptions& o) {
 }
 
 void parse_vio(YamlMap map, sim::VioOptions& o) {
+  map.get("enabled", o.enabled);
   parse_vector3(map, "t_IA_m", o.t_IA_m);
   map.get("odometry_yaw_deg", o.odometry_yaw_deg);
+  map.get("rate_hz", o.rate_hz);
+  map.get("position_drift_fraction", o.position_drift_fraction);
+  map.get("yaw_drift_deg_per_km", o.yaw_drift_deg_per_km);
+  map.get("tilt_drift_deg_per_km", o.tilt_drift_deg_per_km);
+  map.get("device_clock_offset_s", o.device_clock_offset_s);
+  map.get("device_clock_drift_ppm", o.device_clock_drift_ppm);
+  map.get("timesync_jitter_s", o.timesync_jitter_s);
   map.reject_unknown_keys();
 }
 
@@ -437,9 +445,17 @@ void write_scenario_body(Writer& w, const Scenario& s) {
   w.key("cross_m", s.orbit_errors.cross_m);
   w.key("clock_m", s.orbit_errors.clock_m);
   w.section("vio");
+  w.flag("enabled", s.vio.enabled);
   const Eigen::Vector3d& l = s.vio.t_IA_m;
   w.key("t_IA_m", std::string("[") + number(l.x()) + ", " + number(l.y()) + ", " + number(l.z()) + "]");
   w.key("odometry_yaw_deg", s.vio.odometry_yaw_deg);
+  w.key("rate_hz", s.vio.rate_hz);
+  w.key("position_drift_fraction", s.vio.position_drift_fraction);
+  w.key("yaw_drift_deg_per_km", s.vio.yaw_drift_deg_per_km);
+  w.key("tilt_drift_deg_per_km", s.vio.tilt_drift_deg_per_km);
+  w.key("device_clock_offset_s", s.vio.device_clock_offset_s);
+  w.key("device_clock_drift_ppm", s.vio.device_clock_drift_ppm);
+  w.key("timesync_jitter_s", s.vio.timesync_jitter_s);
 }
 
 std::vector<fs::path> scenario_folders() {

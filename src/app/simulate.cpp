@@ -60,19 +60,20 @@ std::string truth_section(const sim::Simulation& sim) {
   line("rover_nlos_signal_epochs", std::to_string(sim.rover.nlos_signal_epochs));
   line("rover_lock_losses", std::to_string(sim.rover.losses));
   line("rover_slips", std::to_string(sim.rover.slips));
-  // VIO frames (VIO output is not simulated yet): the lever arm, and the odometry frame O, gravity-aligned, its
-  // origin at the IMU at the start and its x axis `odometry_yaw_deg` counter-clockwise from east.
-  const sim::TruthSample& first = sim.truth.front();
-  const Eigen::Matrix3d R_EI = first.q_EI.toRotationMatrix();
-  const Eigen::Vector3d p_EI = first.p_E_m - R_EI * sc.vio.t_IA_m;
-  const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_EI)).transpose();
-  const Eigen::Matrix3d R_NO =
-      Eigen::AngleAxisd(sc.vio.odometry_yaw_deg * core::kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Quaterniond q_EO(R_EN * R_NO);
+  // VIO: the lever arm, the odometry frame (gravity-aligned, origin at the IMU's start, see sim/vio.hpp), the device
+  // clock and how far the VIO drifted.
   line("t_IA_m", vec(sc.vio.t_IA_m));
-  line("T_EO", "{q_xyzw: [" + fmt("%.12f", q_EO.x()) + ", " + fmt("%.12f", q_EO.y()) + ", " + fmt("%.12f", q_EO.z()) +
-                   ", " + fmt("%.12f", q_EO.w()) + "], p_m: " + vec(p_EI) + "}");
-  line("vio", "\"not simulated yet: t_IA and T_EO are the values a VIO simulation will use\"");
+  if (sc.vio.enabled && !sim.vio.poses.empty()) {
+    const sim::Pose& T_EO = sim.vio.T_EO;
+    const Eigen::Quaterniond q = T_EO.q.normalized();
+    line("T_EO", "{q_xyzw: [" + fmt("%.12f", q.x()) + ", " + fmt("%.12f", q.y()) + ", " + fmt("%.12f", q.z()) + ", " +
+                     fmt("%.12f", q.w()) + "], p_m: " + vec(T_EO.p) + "}");
+    line("device_clock", "{offset_s: " + fmt("%.9f", sc.vio.device_clock_offset_s) +
+                             ", drift_ppm: " + fmt("%.6f", sc.vio.device_clock_drift_ppm) + "}");
+    const sim::VioSample& last = sim.vio.poses.back();
+    line("vio_final_position_error_m", fmt("%.3f", (last.T_OI.p - last.T_OI_true.p).norm()));
+    line("vio_final_position_sigma_m", fmt("%.3f", std::sqrt(last.covariance.topLeftCorner<3, 3>().trace())));
+  }
   return t;
 }
 

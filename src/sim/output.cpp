@@ -7,6 +7,11 @@
 // kind "building", height_m above the ground), trees (Point, kind "tree", radius_m, bottom_m, top_m), the route
 // (LineString, kind "route", the corner points walked), the base (Point, kind "base", height_m ellipsoidal) and the
 // city origin (Point, kind "origin", ground height_m ellipsoidal).
+// vio.csv (DESIGN.md): header `t_ns,px,py,pz,qx,qy,qz,qw`, then `cov_R_C` for the 21 entries of the upper triangle
+// (row-major) of the 6x6 covariance of xi_OI = [delta p; delta theta], then `xcov_R_C` for the 36 entries
+// (row-major) of cov(xi_OI of the previous row, xi_OI of this row) -- zero on the first row. T_OI as the VIO
+// reports it, device clock.
+// timesync.csv (DESIGN.md): header `t_ns,gps_week,gps_tow_s`: device clock when the built-in GPS gave that time.
 
 #include <cerrno>
 #include <cstdio>
@@ -95,6 +100,46 @@ Status write_city(const Simulation& sim, const std::string& path) {
   return file->close();
 }
 
+Status write_vio(const VioRun& vio, const std::string& path) {
+  auto file = io::TextFileWriter::create(path, "VIO file");
+  if (!file) return file.error();
+  std::string header = "t_ns,px,py,pz,qx,qy,qz,qw";
+  for (int r = 0; r < 6; ++r) {
+    for (int c = r; c < 6; ++c) header += format(",cov_%d_%d", r, c);
+  }
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) header += format(",xcov_%d_%d", r, c);
+  }
+  if (Status s = file->write_line(header); !s) return s;
+  std::string line;
+  for (const VioSample& v : vio.poses) {
+    const Eigen::Quaterniond q = v.T_OI.q.normalized();
+    line = format("%lld,%.6f,%.6f,%.6f,%.12f,%.12f,%.12f,%.12f", static_cast<long long>(v.t_ns), v.T_OI.p.x(),
+                  v.T_OI.p.y(), v.T_OI.p.z(), q.x(), q.y(), q.z(), q.w());
+    for (int r = 0; r < 6; ++r) {
+      for (int c = r; c < 6; ++c) line += format(",%.10e", v.covariance(r, c));
+    }
+    for (int r = 0; r < 6; ++r) {
+      for (int c = 0; c < 6; ++c) line += format(",%.10e", v.cross_previous(r, c));
+    }
+    if (Status s = file->write_line(line); !s) return s;
+  }
+  return file->close();
+}
+
+Status write_timesync(const VioRun& vio, const std::string& path) {
+  auto file = io::TextFileWriter::create(path, "time-sync file");
+  if (!file) return file.error();
+  if (Status s = file->write_line("t_ns,gps_week,gps_tow_s"); !s) return s;
+  for (const TimeSyncSample& t : vio.timesync) {
+    const core::GpsTime n = t.time.normalized();
+    if (Status s = file->write_line(format("%lld,%d,%.3f", static_cast<long long>(t.t_ns), n.week, n.tow_s)); !s) {
+      return s;
+    }
+  }
+  return file->close();
+}
+
 }  // namespace
 
 Status write_simulation(const Simulation& sim, const std::string& dir) {
@@ -105,7 +150,10 @@ Status write_simulation(const Simulation& sim, const std::string& dir) {
   if (Status s = io::write_rinex_obs((d / "rover.obs").string(), sim.rover.header, sim.rover.epochs); !s) return s;
   if (Status s = io::write_rinex_obs((d / "base.obs").string(), sim.base.header, sim.base.epochs); !s) return s;
   if (Status s = write_truth(sim, (d / "truth.csv").string()); !s) return s;
-  return write_city(sim, (d / "city.geojson").string());
+  if (Status s = write_city(sim, (d / "city.geojson").string()); !s) return s;
+  if (!sim.scenario.vio.enabled) return Ok{};
+  if (Status s = write_vio(sim.vio, (d / "vio.csv").string()); !s) return s;
+  return write_timesync(sim.vio, (d / "timesync.csv").string());
 }
 
 }  // namespace canyon::sim

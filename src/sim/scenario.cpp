@@ -222,6 +222,13 @@ std::string Scenario::validate() const {
   r.require(vio.t_IA_m.allFinite() && vio.t_IA_m.norm() < 10.0, "vio.t_IA_m", "must be finite and shorter than 10 m",
             vio.t_IA_m.norm());
   r.range(vio.odometry_yaw_deg, -360.0, 360.0, "vio.odometry_yaw_deg");
+  r.range(vio.rate_hz, 1.0, 200.0, "vio.rate_hz");
+  r.range(vio.position_drift_fraction, 0.0, 0.2, "vio.position_drift_fraction");
+  r.range(vio.yaw_drift_deg_per_km, 0.0, 90.0, "vio.yaw_drift_deg_per_km");
+  r.range(vio.tilt_drift_deg_per_km, 0.0, 90.0, "vio.tilt_drift_deg_per_km");
+  r.range(vio.device_clock_offset_s, 0.0, 1e8, "vio.device_clock_offset_s");
+  r.range(vio.device_clock_drift_ppm, -1000.0, 1000.0, "vio.device_clock_drift_ppm");
+  r.range(vio.timesync_jitter_s, 0.0, 1.0, "vio.timesync_jitter_s");
   return r.message();
 }
 

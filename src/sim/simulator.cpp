@@ -577,12 +577,7 @@ std::vector<TruthSample> rover_truth(const Scenario& sc, const Trajectory& traje
     TruthSample s;
     s.time = sc.start + t_s;
     s.p_E_m = origin_E + R_EN * trajectory.antenna_N(t_s);
-    const Eigen::Vector2d h = trajectory.heading_N(t_s);
-    Eigen::Matrix3d R_NI;
-    R_NI.col(0) = Eigen::Vector3d(h.x(), h.y(), 0.0);
-    R_NI.col(2) = Eigen::Vector3d::UnitZ();
-    R_NI.col(1) = R_NI.col(2).cross(R_NI.col(0));
-    s.q_EI = Eigen::Quaterniond(R_EN * R_NI).normalized();
+    s.q_EI = Eigen::Quaterniond(R_EN * body_attitude_N(trajectory, t_s)).normalized();
     out.push_back(s);
   }
   return out;
@@ -631,6 +626,7 @@ Result<Simulation> simulate(const Scenario& scenario, const std::string& nav_pat
   base.receiver_id = 2;
   sim.base = ReceiverSimulator(base, store, satellites, sats, iono, tropo).run();
   sim.base.header = obs_header(scenario, true, sim.base_p_E_m, sim.nav, scenario.base.rate_hz);
+  if (scenario.vio.enabled) sim.vio = simulate_vio(scenario, sim.trajectory, scenario.seed);
   return sim;
 }
 

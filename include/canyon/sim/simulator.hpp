@@ -29,6 +29,7 @@
 #include "canyon/sim/city.hpp"
 #include "canyon/sim/route.hpp"
 #include "canyon/sim/scenario.hpp"
+#include "canyon/sim/vio.hpp"
 
 namespace canyon::sim {
 
@@ -94,6 +95,7 @@ struct Simulation {
   ReceiverRun rover;
   ReceiverRun base;
   std::vector<TruthSample> truth;
+  VioRun vio;  ///< empty when scenario.vio.enabled is false
 };
 
 struct SimulationOptions {
@@ -106,8 +108,9 @@ struct SimulationOptions {
 Result<Simulation> simulate(const Scenario& scenario, const std::string& nav_path,
                             const SimulationOptions& options = {});
 
-/// Writes rover.obs, base.obs (RINEX 3.04), truth.csv and city.geojson into `dir` (created if needed). RINEX
-/// headers carry a fixed program date derived from the scenario start, so the files depend on the scenario only.
+/// Writes rover.obs, base.obs (RINEX 3.04), truth.csv, city.geojson and, with VIO enabled, vio.csv and timesync.csv
+/// into `dir` (created if needed). RINEX headers carry a fixed program date derived from the scenario start, so the
+/// files depend on the scenario only.
 Status write_simulation(const Simulation& simulation, const std::string& dir);
 
 }  // namespace canyon::sim
