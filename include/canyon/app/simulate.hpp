@@ -7,9 +7,12 @@
 //   base.obs      RINEX 3.04 observations of the base; APPROX POSITION XYZ is its true antenna position
 //   truth.csv     gps_week,gps_tow_s,x,y,z,qx,qy,qz,qw: rover antenna (ECEF, m) and R_EI at every rover epoch
 //   city.geojson  buildings (footprint, height), trees, route, base and origin (WGS84 lon/lat)
+//   vio.csv       the device's VIO poses T_OI (device clock, odometry frame) with covariances and consecutive-pose
+//                 cross-covariances (DESIGN.md contract; see canyon/sim/vio.hpp)
+//   timesync.csv  t_ns,gps_week,gps_tow_s: device clock at each GPST second from the built-in GPS
 //   scenario.yaml the effective scenario (every key; `canyon simulate --scenario DIR/scenario.yaml` regenerates the
 //                 same files) and a `truth:` section with the true parameters: base position, receiver clocks, the
-//                 city realised, lever arm t_IA and odometry frame T_EO (for the VIO part, not simulated yet)
+//                 city realised, lever arm t_IA, odometry frame T_EO, device clock, final VIO error
 // The same scenario and seed give the same files, byte for byte.
 
 #include <string>
