@@ -27,7 +27,7 @@ test::CommandResult canyon(const std::string& args) {
 
 /// Generates `scenario` for 180 s into a fresh folder of its own (`tag`: tests may run in parallel).
 fs::path generate(const std::string& scenario, const std::string& tag) {
-  const fs::path dir = test::temp_dir("simulate") / tag;
+  fs::path dir = test::temp_dir("simulate") / tag;
   fs::remove_all(dir);
   const auto r = canyon("simulate -q --scenario " + scenario + " --duration 180 --out " + dir.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -47,7 +47,7 @@ eval::SolutionStats score(const fs::path& pos, const fs::path& dir) {
 }
 
 fs::path run_rtklib(const fs::path& dir) {
-  const fs::path pos = dir / "rtklib.pos";
+  fs::path pos = dir / "rtklib.pos";
   const std::string conf = std::string(CANYON_SOURCE_DIR) + "/tests/bench/rtklib-sim.conf";
   const auto r = test::run_command("rnx2rtkp -k " + conf + " -o " + pos.string() + " " + (dir / "rover.obs").string() +
                                    " " + (dir / "base.obs").string() + " " + (dir / "nav.rnx").string());
