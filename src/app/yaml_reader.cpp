@@ -78,6 +78,52 @@ void YamlMap::get(const std::string& key, std::vector<std::string>& out) {
   out = std::move(items);
 }
 
+namespace {
+
+/// The numbers of a sequence node; false if it is not a sequence of numbers.
+bool read_numbers(const YAML::Node& node, std::vector<double>& out) {
+  if (!node.IsSequence()) return false;
+  std::vector<double> values;
+  for (const auto& item : node) {
+    if (!item.IsScalar()) return false;
+    try {
+      values.push_back(item.as<double>());
+    } catch (const YAML::Exception&) {
+      return false;
+    }
+  }
+  out = std::move(values);
+  return true;
+}
+
+}  // namespace
+
+void YamlMap::get(const std::string& key, std::vector<double>& out) {
+  asked_.insert(key);
+  if (!has(key)) return;
+  if (!read_numbers(node_[key], out)) fail(key, "must be a list of numbers");
+}
+
+void YamlMap::get(const std::string& key, std::vector<std::vector<double>>& out) {
+  asked_.insert(key);
+  if (!has(key)) return;
+  const YAML::Node value = node_[key];
+  if (!value.IsSequence()) {
+    fail(key, "must be a list of lists of numbers");
+    return;
+  }
+  std::vector<std::vector<double>> rows;
+  for (const auto& item : value) {
+    std::vector<double> row;
+    if (!read_numbers(item, row)) {
+      fail(key, "must be a list of lists of numbers");
+      return;
+    }
+    rows.push_back(std::move(row));
+  }
+  out = std::move(rows);
+}
+
 YamlMap YamlMap::sub(const std::string& key) {
   asked_.insert(key);
   YamlMap child(has(key) ? node_[key] : YAML::Node(), file_, key_path(key));

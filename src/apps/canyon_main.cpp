@@ -1,6 +1,7 @@
 // The `canyon` command: subcommands for canyon's jobs. Exit codes: 0 success, 1 bad input or failed run,
 // 2 bad command line or configuration.
 
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -10,6 +11,8 @@
 
 #include "canyon/app/process.hpp"
 #include "canyon/app/process_config.hpp"
+#include "canyon/app/scenario_config.hpp"
+#include "canyon/app/simulate.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/satellite.hpp"
 
@@ -176,11 +179,64 @@ int run_process_command(const ProcessArgs& args) {
   return summary->solved > 0 ? 0 : kExitInput;
 }
 
+struct SimulateArgs {
+  std::string scenario;
+  std::string out;
+  std::int64_t seed = -1;
+  double duration_s = -1.0;
+  bool quiet = false;
+};
+
+void add_simulate_command(CLI::App& app, SimulateArgs& args) {
+  CLI::App* cmd = app.add_subcommand(
+      "simulate", "Generate a scenario: rover and base RINEX, navigation, ground truth and city model");
+  cmd->add_option("--scenario", args.scenario,
+                  "Shipped scenario name (open-sky, light-blocked, urban-moderate, urban-severe) or a FILE.yaml")
+      ->required();
+  cmd->add_option("--seed", args.seed, "Random seed (default: the scenario's)")->check(CLI::Range(0LL, 1LL << 53));
+  cmd->add_option("--duration", args.duration_s, "Duration in seconds (default: the scenario's)")
+      ->check(CLI::Range(1.0, 86400.0));
+  cmd->add_option("--out", args.out, "Output folder (created if needed)")->required();
+  cmd->add_flag("-q,--quiet", args.quiet, "No summary line");
+}
+
+int run_simulate_command(const SimulateArgs& args) {
+  auto file = canyon::app::find_scenario_file(args.scenario);
+  if (!file) {
+    std::cerr << "canyon: error: " << file.error().to_string() << "\n";
+    return kExitUsage;
+  }
+  auto scenario = canyon::app::load_scenario(*file);
+  if (!scenario) {
+    std::cerr << "canyon: error: " << scenario.error().to_string() << "\n";
+    return kExitUsage;
+  }
+  if (args.seed >= 0) scenario->seed = static_cast<std::uint64_t>(args.seed);
+  if (args.duration_s > 0.0) scenario->duration_s = args.duration_s;
+  auto summary = canyon::app::run_simulate(*scenario, args.out);
+  if (!summary) {
+    std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
+    return kExitInput;
+  }
+  if (!args.quiet) {
+    std::fprintf(stderr,
+                 "canyon simulate: %s seed %llu: %d rover epochs, %d base epochs, %d rover signals (%.1f %% NLOS), "
+                 "%d lock losses, %d slips, %d buildings, route %.0f m, %.2f s wall, files in %s\n",
+                 scenario->name.c_str(), static_cast<unsigned long long>(scenario->seed), summary->rover_epochs,
+                 summary->base_epochs, summary->rover_signal_epochs, 100.0 * summary->nlos_fraction,
+                 summary->rover_losses, summary->rover_slips, summary->buildings, summary->route_length_m,
+                 summary->wall_s, args.out.c_str());
+  }
+  return 0;
+}
+
 int run_main(int argc, char** argv) {
   CLI::App app{"canyon: centimetre-level GNSS carrier-phase positioning fused with visual-inertial odometry"};
   app.require_subcommand(1);
   ProcessArgs process_args;
   add_process_command(app, process_args);
+  SimulateArgs simulate_args;
+  add_simulate_command(app, simulate_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -192,6 +248,7 @@ int run_main(int argc, char** argv) {
     return kExitUsage;
   }
   if (app.got_subcommand("process")) return run_process_command(process_args);
+  if (app.got_subcommand("simulate")) return run_simulate_command(simulate_args);
   return kExitUsage;
 }
 

@@ -142,7 +142,8 @@ void write_header(std::string& out, const RinexObsHeader& header, const TypeList
                   const std::vector<core::ObsEpoch>& epochs) {
   const char system = types.size() == 1 ? core::system_letter(types.begin()->first) : 'M';
   add_header_line(out, format("%9.2f           %-20s%-20c", 3.04, "OBSERVATION DATA", system), "RINEX VERSION / TYPE");
-  add_header_line(out, format("%-20s%-20s%-20s", "canyon", "", utc_now().c_str()), "PGM / RUN BY / DATE");
+  const std::string date = header.program_date.empty() ? utc_now() : header.program_date.substr(0, 20);
+  add_header_line(out, format("%-20s%-20s%-20s", "canyon", "", date.c_str()), "PGM / RUN BY / DATE");
   const core::ReceiverInfo& rx = header.receiver;
   add_header_line(out, rx.marker_name, "MARKER NAME");
   add_header_line(out, format("%-20s%-20.20s%-20s", "", rx.receiver_type.c_str(), ""), "REC # / TYPE / VERS");

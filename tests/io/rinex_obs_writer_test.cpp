@@ -141,6 +141,26 @@ TEST(RinexObservationWriter, ValueOutOfRangeIsAnError) {
   EXPECT_EQ(written.error().file, path);
 }
 
+TEST(RinexObservationWriter, FixedProgramDateMakesTheFileDependOnItsContentOnly) {
+  test::TempDir tmp;
+  RinexObsHeader header;
+  header.program_date = "20230614 180000 GPS";
+  const std::string a = tmp.file("a.rnx"), b = tmp.file("b.rnx");
+  ASSERT_TRUE(write_rinex_obs(a, header, make_epochs()).ok());
+  ASSERT_TRUE(write_rinex_obs(b, header, make_epochs()).ok());
+  const auto read_all = [](const std::string& path) {
+    std::ostringstream text;
+    text << std::ifstream(path, std::ios::binary).rdbuf();
+    return text.str();
+  };
+  EXPECT_EQ(read_all(a), read_all(b));
+  EXPECT_NE(read_all(a).find("canyon                                  20230614 180000 GPS PGM / RUN BY / DATE\n"),
+            std::string::npos);
+  // Without it, the writer stamps the current UTC time.
+  ASSERT_TRUE(write_rinex_obs(a, {}, make_epochs()).ok());
+  EXPECT_NE(read_all(a).find(" UTC PGM / RUN BY / DATE\n"), std::string::npos);
+}
+
 TEST(RinexObservationWriter, UnwritablePathIsAnError) {
   const Status written = write_rinex_obs("/nonexistent/canyon/out.rnx", {}, {});
   ASSERT_FALSE(written.ok());

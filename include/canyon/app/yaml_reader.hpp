@@ -25,6 +25,10 @@ class YamlMap {
   void get(const std::string& key, bool& out);
   void get(const std::string& key, std::string& out);
   void get(const std::string& key, std::vector<std::string>& out);
+  /// A list of numbers ([1, 2.5, 3]).
+  void get(const std::string& key, std::vector<double>& out);
+  /// A list of lists of numbers ([[0, 0], [100, 0]]).
+  void get(const std::string& key, std::vector<std::vector<double>>& out);
   /// The sub-map at `key` (empty if absent).
   [[nodiscard]] YamlMap sub(const std::string& key);
   [[nodiscard]] bool has(const std::string& key) const;

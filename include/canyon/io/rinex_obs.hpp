@@ -44,6 +44,9 @@ struct RinexObsHeader {
   double interval_s = 0.0;          ///< 0 if not given
   std::optional<int> leap_seconds;  ///< GPST - UTC if given
   std::string time_system = "GPS";  ///< of the epoch time tags in the file: GPS, GLO, GAL, BDT, QZS
+  /// Writer only: the date field of "PGM / RUN BY / DATE" ("yyyymmdd hhmmss zone", at most 20 characters). Empty:
+  /// the current UTC time. A fixed value makes the written file depend on its content only (simulations).
+  std::string program_date;
 };
 
 class RinexObsReader {

@@ -1,0 +1,86 @@
+#pragma once
+// Visual-inertial odometry of the head-worn device, as a real VIO reports it: poses T_OI of the IMU in the device's
+// own odometry frame O, stamped with the device clock, drifting with the distance walked, with covariances that
+// describe exactly that drift; and the time-sync pairs of the device's built-in GPS.
+//
+// Frames: I is the IMU/body frame (x along the walking direction, y left, z up; the wearer keeps the head level);
+// the antenna is at t_IA in I. O is gravity-aligned (the ENU frame N at the city origin rotated by
+// `odometry_yaw_deg` about up), with its origin at the IMU's start position: T_EO = (R_EN R_NO, p_E_I(start)), and
+// the true VIO pose is T_OI = T_EO^-1 T_EI.
+//
+// Drift model (right perturbation, xi = [delta p; delta theta], T_est = T Exp(xi), as in DESIGN.md): each pose
+// composes the true increment with a random one,
+//   T_est,k = T_est,k-1 dT_k Exp(n_k),   dT_k = T_k-1^-1 T_k,   n_k ~ N(0, Q_k),
+//   Q_k = d_k / 1000 m * diag(s_p^2, s_p^2, s_p^2, s_t^2, s_t^2, s_y^2),
+// d_k the distance walked in the step, s_p = position_drift_fraction * 1000 m / sqrt(3) (per axis, so that the 3-D
+// translation random walk is position_drift_fraction of 1 km after 1 km), s_y, s_t the heading and tilt random walks
+// after 1 km. The heading error bends the path, so the position drift grows faster than sqrt(distance); with the
+// defaults (0.4 %, 0.3 deg) the 1-sigma 3-D error after a straight kilometre is about 0.5 % of it. The reported
+// covariance is propagated to first order:
+//   P_k = A_k P_k-1 A_k^T + Q_k,   A_k = Ad(dT_k^-1),   cov(xi_k-1, xi_k) = P_k-1 A_k^T,
+// with Ad(T) = [[R, [t]x R], [0, R]] for the [translation; rotation] ordering; P_0 = diag(1e-8 m^2 x 3,
+// 1e-10 rad^2 x 3) (O is defined by the first pose).
+//
+// Clocks: the device clock reads t_ns = (device_clock_offset_s + (t - start)(1 + drift_ppm 1e-6)) 1e9 at GPST t.
+// Poses are at every 1 / rate_hz of device time; time-sync pairs at every whole GPST second, their device time with
+// Gaussian jitter.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "canyon/core/geodesy.hpp"
+#include "canyon/core/time.hpp"
+#include "canyon/sim/route.hpp"
+#include "canyon/sim/scenario.hpp"
+
+namespace canyon::sim {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+/// A rigid transform (rotation and translation) in SE(3).
+struct Pose {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+
+  [[nodiscard]] Pose operator*(const Pose& b) const { return {q * b.q, p + q * b.p}; }
+  [[nodiscard]] Pose inverse() const { return {q.conjugate(), -(q.conjugate() * p)}; }
+};
+
+/// SE(3) exponential and logarithm for xi = [translation part; rotation vector].
+[[nodiscard]] Pose se3_exp(const Vector6d& xi);
+[[nodiscard]] Vector6d se3_log(const Pose& T);
+/// Adjoint of T for the [translation; rotation] ordering: Exp(Ad(T) xi) = T Exp(xi) T^-1.
+[[nodiscard]] Matrix6d se3_adjoint(const Pose& T);
+
+struct VioSample {
+  std::int64_t t_ns = 0;                       ///< device clock
+  core::GpsTime time;                          ///< true GPST of the pose
+  Pose T_OI;                                   ///< as the VIO reports it
+  Pose T_OI_true;                              ///< ground truth
+  Matrix6d covariance = Matrix6d::Zero();      ///< of xi_OI
+  Matrix6d cross_previous = Matrix6d::Zero();  ///< cov(xi of the previous sample, xi of this one); 0 for the first
+};
+
+struct TimeSyncSample {
+  std::int64_t t_ns = 0;  ///< device clock when the built-in GPS reported `time`
+  core::GpsTime time;
+};
+
+struct VioRun {
+  std::vector<VioSample> poses;
+  std::vector<TimeSyncSample> timesync;
+  Pose T_EO;  ///< true odometry frame in ECEF
+};
+
+/// The device's VIO and time sync along the rover trajectory of `scenario` (its city origin and start time). The
+/// same seed gives the same run.
+[[nodiscard]] VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std::uint64_t seed);
+
+/// Body attitude R_NI at time t_s (seconds since the start): level, x along the walking direction.
+[[nodiscard]] Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s);
+
+}  // namespace canyon::sim

@@ -1,0 +1,158 @@
+// Simulated visual-inertial odometry and device time sync (see vio.hpp).
+
+#include "canyon/sim/vio.hpp"
+
+#include <cmath>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/sim/random.hpp"
+
+namespace canyon::sim {
+namespace {
+
+constexpr std::uint64_t kVioStream = 0x710, kSyncStream = 0x5C;
+constexpr double kSmallAngleRad = 1e-9;
+constexpr double kInitialPositionVarM2 = 1e-8;
+constexpr double kInitialAngleVarRad2 = 1e-10;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+/// Left Jacobian of SO(3), V(phi) of the SE(3) exponential.
+Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  const Eigen::Matrix3d k = skew(phi);
+  if (theta < kSmallAngleRad) return Eigen::Matrix3d::Identity() + 0.5 * k;
+  const double t2 = theta * theta;
+  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * k +
+         (theta - std::sin(theta)) / (t2 * theta) * k * k;
+}
+
+Eigen::Quaterniond so3_exp(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  if (theta < kSmallAngleRad) return Eigen::Quaterniond(1.0, 0.5 * phi.x(), 0.5 * phi.y(), 0.5 * phi.z()).normalized();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(theta, phi / theta));
+}
+
+Eigen::Vector3d so3_log(const Eigen::Quaterniond& q) {
+  const Eigen::AngleAxisd aa(q.normalized());
+  const double angle = aa.angle() > core::kPi ? aa.angle() - 2.0 * core::kPi : aa.angle();
+  return angle * aa.axis();
+}
+
+/// Device clock reading (ns) at `t_s` seconds after the start.
+double device_ns(const VioOptions& o, double t_s) {
+  return (o.device_clock_offset_s + t_s * (1.0 + o.device_clock_drift_ppm * 1e-6)) * 1e9;
+}
+
+/// Seconds after the start at which the device clock reads `t_ns`.
+double true_seconds(const VioOptions& o, double t_ns) {
+  return (t_ns * 1e-9 - o.device_clock_offset_s) / (1.0 + o.device_clock_drift_ppm * 1e-6);
+}
+
+/// True body pose in the city frame N: (R_NI, p_N_I).
+Pose body_pose_N(const Trajectory& trajectory, const Eigen::Vector3d& t_IA, double t_s) {
+  const Eigen::Matrix3d R_NI = body_attitude_N(trajectory, t_s);
+  return {Eigen::Quaterniond(R_NI), trajectory.antenna_N(t_s) - R_NI * t_IA};
+}
+
+Matrix6d step_noise(const VioOptions& o, double distance_m) {
+  const double per_km = distance_m / 1000.0;
+  const double s_p = o.position_drift_fraction * 1000.0 / std::sqrt(3.0);
+  const double s_t = o.tilt_drift_deg_per_km * core::kDegToRad;
+  const double s_y = o.yaw_drift_deg_per_km * core::kDegToRad;
+  Vector6d d;
+  d << s_p * s_p, s_p * s_p, s_p * s_p, s_t * s_t, s_t * s_t, s_y * s_y;
+  return (per_km * d).asDiagonal();
+}
+
+}  // namespace
+
+Pose se3_exp(const Vector6d& xi) {
+  const Eigen::Vector3d phi = xi.tail<3>();
+  return {so3_exp(phi), so3_left_jacobian(phi) * xi.head<3>()};
+}
+
+Vector6d se3_log(const Pose& T) {
+  const Eigen::Vector3d phi = so3_log(T.q);
+  Vector6d xi;
+  xi << so3_left_jacobian(phi).inverse() * T.p, phi;
+  return xi;
+}
+
+Matrix6d se3_adjoint(const Pose& T) {
+  const Eigen::Matrix3d R = T.q.toRotationMatrix();
+  Matrix6d ad = Matrix6d::Zero();
+  ad.topLeftCorner<3, 3>() = R;
+  ad.topRightCorner<3, 3>() = skew(T.p) * R;
+  ad.bottomRightCorner<3, 3>() = R;
+  return ad;
+}
+
+Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s) {
+  const Eigen::Vector2d h = trajectory.heading_N(t_s);
+  Eigen::Matrix3d R_NI;
+  R_NI.col(0) = Eigen::Vector3d(h.x(), h.y(), 0.0);
+  R_NI.col(2) = Eigen::Vector3d::UnitZ();
+  R_NI.col(1) = R_NI.col(2).cross(R_NI.col(0));
+  return R_NI;
+}
+
+VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std::uint64_t seed) {
+  const VioOptions& o = scenario.vio;
+  VioRun run;
+  // T_EO: O is the city ENU frame rotated by the odometry yaw, at the IMU's start position.
+  const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(scenario.origin).transpose();
+  const Eigen::Vector3d origin_E = core::geodetic_to_ecef(scenario.origin);
+  const Pose T_NO{Eigen::Quaterniond(Eigen::AngleAxisd(o.odometry_yaw_deg * core::kDegToRad, Eigen::Vector3d::UnitZ())),
+                  body_pose_N(trajectory, o.t_IA_m, 0.0).p};
+  const Pose T_EN{Eigen::Quaterniond(R_EN), origin_E};
+  run.T_EO = T_EN * T_NO;
+  const Pose T_ON = T_NO.inverse();
+
+  Rng rng = Rng::stream(seed, kVioStream);
+  const double first_ns = std::ceil(device_ns(o, 0.0));
+  const double step_ns = 1e9 / o.rate_hz;
+  Pose estimate;
+  Pose previous_true;
+  Matrix6d P = Matrix6d::Zero();
+  P.diagonal() << Eigen::Vector3d::Constant(kInitialPositionVarM2), Eigen::Vector3d::Constant(kInitialAngleVarRad2);
+  for (int k = 0;; ++k) {
+    const double t_ns = first_ns + std::round(k * step_ns);
+    const double t_s = true_seconds(o, t_ns);
+    if (t_s > scenario.duration_s) break;
+    VioSample s;
+    s.t_ns = static_cast<std::int64_t>(t_ns);
+    s.time = scenario.start + t_s;
+    s.T_OI_true = T_ON * body_pose_N(trajectory, o.t_IA_m, t_s);
+    if (k == 0) {
+      estimate = s.T_OI_true;
+    } else {
+      const Pose dT = previous_true.inverse() * s.T_OI_true;
+      const Matrix6d Q = step_noise(o, dT.p.norm());
+      Vector6d n;
+      for (int i = 0; i < 6; ++i) n(i) = std::sqrt(Q(i, i)) * rng.normal();
+      estimate = estimate * dT * se3_exp(n);
+      const Matrix6d A = se3_adjoint(dT.inverse());
+      s.cross_previous = P * A.transpose();
+      P = A * P * A.transpose() + Q;
+    }
+    s.T_OI = estimate;
+    s.covariance = 0.5 * (P + P.transpose());
+    previous_true = s.T_OI_true;
+    run.poses.push_back(s);
+  }
+  Rng sync_rng = Rng::stream(seed, kSyncStream);
+  for (int second = 0; second <= static_cast<int>(std::floor(scenario.duration_s)); ++second) {
+    TimeSyncSample t;
+    t.time = scenario.start + static_cast<double>(second);
+    t.t_ns = std::llround(device_ns(o, second) + o.timesync_jitter_s * 1e9 * sync_rng.normal());
+    run.timesync.push_back(t);
+  }
+  return run;
+}
+
+}  // namespace canyon::sim
