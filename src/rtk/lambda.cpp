@@ -144,11 +144,9 @@ Status factorise_with_pivoting(const Eigen::MatrixXd& Q, Eigen::MatrixXd& W, con
   return Ok{};
 }
 
-/// Integer Gauss transformation G_ik (i > k) applied to L, Z, Z_inv_T and z_hat; false when L_ik is already reduced.
-bool gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
+/// Integer Gauss transformation G_ik (i > k) with multiplier mu != 0 applied to L, Z, Z_inv_T and z_hat.
+void apply_gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k, double mu) {
   const Eigen::Index n = v.n;
-  const double mu = gauss_multiplier(v.L[i + k * n]);
-  if (mu == 0.0) return false;
   double* L_k = v.L + k * n;
   const double* L_i = v.L + i * n;
   for (Eigen::Index r = i; r < n; ++r) L_k[r] -= mu * L_i[r];
@@ -163,7 +161,13 @@ bool gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
     v.log->push_back({i, k, mu});
   }
   if (v.z_hat != nullptr) v.z_hat[k] -= mu * v.z_hat[i];
-  return true;
+}
+
+/// G_ik with mu = round(L_ik), or nothing when L_ik is already reduced: the common case, one load and compare
+/// (inline; the reduction makes millions of these tests on a file).
+inline void gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
+  const double mu = gauss_multiplier(v.L[i + k * v.n]);
+  if (mu != 0.0) apply_gauss_transform(v, i, k, mu);
 }
 
 /// Swap of neighbours k, k+1 given Delta = d_k + L_{k+1,k}^2 d_{k+1} (formulas at the top of this file).
@@ -212,7 +216,10 @@ Status reduce(const ReductionView& v) {
       // cannot grow over repeated swaps (the instability of reducing the sub-diagonal only). Leaves L_{k+1,k}, d.
       for (Eigen::Index i = k + 2; i < n; ++i) gauss_transform(v, i, k);
       swap_neighbours(v, k, delta);
-      k = n - 2;
+      // MLAMBDA restarts from k = n - 2; levels above k + 1 are untouched by this swap (their L_{j+1,j} and d
+      // are those already reduced and tested), so those tests would fail again with no Gauss transformation:
+      // resuming at k + 1 gives the same sequence of operations in O(1) instead of O(n) steps per swap.
+      k = std::min(k + 1, n - 2);
     } else {
       --k;
     }
