@@ -85,15 +85,68 @@ struct DdRow {
     }
     entries[static_cast<std::size_t>(num_entries++)] = {index, coefficient};
   }
-  /// This row times the columns of M (M has the state dimension as rows): (H M) for one row.
-  [[nodiscard]] Eigen::RowVectorXd times(const Eigen::MatrixXd& M) const {
-    Eigen::RowVectorXd r = h_pos.transpose() * M.topRows<3>();
+  /// h . c for a state-sized column c (e.g. a column of P H^T).
+  [[nodiscard]] double dot(const Eigen::Ref<const Eigen::VectorXd>& c) const {
+    double sum = h_pos.dot(c.head<3>());
     for (int k = 0; k < num_entries; ++k) {
-      r += entries[static_cast<std::size_t>(k)].second * M.row(entries[static_cast<std::size_t>(k)].first);
+      sum += entries[static_cast<std::size_t>(k)].second * c[entries[static_cast<std::size_t>(k)].first];
     }
-    return r;
+    return sum;
+  }
+  /// P h for a symmetric P: one column of P H^T, from columns of P.
+  void covariance_times(const Eigen::MatrixXd& P, Eigen::Ref<Eigen::VectorXd> P_h) const {
+    P_h = h_pos[0] * P.col(0) + h_pos[1] * P.col(1) + h_pos[2] * P.col(2);
+    for (int k = 0; k < num_entries; ++k) {
+      P_h += entries[static_cast<std::size_t>(k)].second * P.col(entries[static_cast<std::size_t>(k)].first);
+    }
   }
 };
+
+// Dense kernels of the Kalman update, for the sizes of RTK (tens of states and measurements), where Eigen's blocked
+// general-purpose routines spend more on packing and blocking than on arithmetic. Column major throughout: every
+// inner loop runs down a contiguous column.
+
+/// In-place Cholesky factorisation A = L L^T of a symmetric positive definite m x m matrix given by its lower
+/// triangle; L overwrites the lower triangle, the strict upper triangle is neither read nor written. False if A is
+/// not positive definite.
+bool cholesky_lower_in_place(Eigen::MatrixXd& A) {
+  const Eigen::Index m = A.rows();
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const double pivot = A(k, k);
+    if (!(pivot > 0.0)) return false;
+    const double l_kk = std::sqrt(pivot);
+    A(k, k) = l_kk;
+    A.col(k).tail(m - k - 1) /= l_kk;
+    for (Eigen::Index j = k + 1; j < m; ++j) A.col(j).tail(m - j) -= A(j, k) * A.col(k).tail(m - j);
+  }
+  return true;
+}
+
+/// Solves L Y = B in place for Y (L lower triangular m x m, stored in the lower triangle; B m x n).
+void solve_lower_in_place(const Eigen::MatrixXd& L, Eigen::MatrixXd& B) {
+  const Eigen::Index m = L.rows();
+  for (Eigen::Index j = 0; j < B.cols(); ++j) {
+    auto b = B.col(j);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const double y_k = b[k] / L(k, k);
+      b[k] = y_k;
+      b.tail(m - k - 1) -= y_k * L.col(k).tail(m - k - 1);
+    }
+  }
+}
+
+/// P <- sym(P) - Y^T Y for an n x n P and an m x n Y, where sym(P) = (P + P^T) / 2 (P itself when symmetric): the
+/// lower triangle from dot products of columns of Y, mirrored, so that P is exactly symmetric afterwards.
+void subtract_gram_symmetric(Eigen::MatrixXd& P, const Eigen::MatrixXd& Y) {
+  const Eigen::Index n = P.rows();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = j; i < n; ++i) {
+      const double p_ij = 0.5 * (P(i, j) + P(j, i)) - Y.col(i).dot(Y.col(j));
+      P(i, j) = p_ij;
+      P(j, i) = p_ij;
+    }
+  }
+}
 
 }  // namespace
 
@@ -362,46 +415,48 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
   }
   if (rows.empty()) return 0;
   const auto m = static_cast<Eigen::Index>(rows.size());
-  Eigen::VectorXd v(m);
-  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, m);
-  // P H^T column by column from the sparse rows (P is symmetric: column a of P H^T is row a of H P, transposed).
+  // P H^T column by column (P h_a from columns of P, h_a sparse) and the innovations.
   Eigen::MatrixXd PHt(n, m);
+  Eigen::VectorXd v(m);
   for (Eigen::Index a = 0; a < m; ++a) {
+    const DdRow& row = rows[static_cast<std::size_t>(a)];
+    row.covariance_times(P_, PHt.col(a));
+    v[a] = row.innovation_m;
+  }
+  // DD measurement covariance: the SD variances of s and of its reference on the diagonal; rows of one kind that
+  // share a reference are correlated through it.
+  const auto sd_variance = [&](const DdRow& row, int i) {
+    const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+    return row.phase ? sd.phase_variance_m2 : sd.code_variance_m2;
+  };
+  const auto measurement_covariance = [&](Eigen::Index a, Eigen::Index b) {
     const DdRow& ra = rows[static_cast<std::size_t>(a)];
-    PHt.col(a) = ra.times(P_).transpose();
-    v[a] = ra.innovation_m;
-    const auto variance = [&](int i) {
-      const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
-      return ra.phase ? sd.phase_variance_m2 : sd.code_variance_m2;
-    };
-    R(a, a) = variance(ra.sd) + variance(ra.reference);
-    for (Eigen::Index b = 0; b < a; ++b) {
-      const DdRow& rb = rows[static_cast<std::size_t>(b)];
-      if (rb.phase == ra.phase && rb.reference == ra.reference) R(a, b) = R(b, a) = variance(ra.reference);
+    const DdRow& rb = rows[static_cast<std::size_t>(b)];
+    if (a == b) return sd_variance(ra, ra.sd) + sd_variance(ra, ra.reference);
+    return rb.phase == ra.phase && rb.reference == ra.reference ? sd_variance(ra, ra.reference) : 0.0;
+  };
+  // S = H P H^T + R (lower triangle), factorised in place: S = L L^T.
+  Eigen::MatrixXd S(m, m);
+  for (Eigen::Index b = 0; b < m; ++b) {
+    for (Eigen::Index a = b; a < m; ++a) {
+      S(a, b) = rows[static_cast<std::size_t>(a)].dot(PHt.col(b)) + measurement_covariance(a, b);
     }
   }
-  // S = H P H^T + R, row by row from the sparse rows: S_a = H_a (P H^T).
-  Eigen::MatrixXd S = R;
-  for (Eigen::Index a = 0; a < m; ++a) S.row(a) += rows[static_cast<std::size_t>(a)].times(PHt);
-  S = 0.5 * (S + S.transpose()).eval();
-  // Kalman update: K = P H^T S^-1.
-  const Eigen::LLT<Eigen::MatrixXd> llt(S);
-  if (llt.info() != Eigen::Success) return 0;
-  const Eigen::MatrixXd L_inv_HP = llt.matrixL().solve(PHt.transpose());  // L^-1 H P, m x n
-  const Eigen::VectorXd dx = PHt * llt.solve(v);
+  if (!cholesky_lower_in_place(S)) return 0;
+  // Kalman update with K = P H^T S^-1:  dx = (L^-1 H P)^T (L^-1 v),  P' = P - (L^-1 H P)^T (L^-1 H P).
+  Eigen::MatrixXd L_inv_HP = PHt.transpose();
+  solve_lower_in_place(S, L_inv_HP);
+  Eigen::VectorXd L_inv_v = v;
+  S.triangularView<Eigen::Lower>().solveInPlace(L_inv_v);
+  const Eigen::VectorXd dx = L_inv_HP.transpose() * L_inv_v;
   x_ += dx;
-  P_.noalias() -= L_inv_HP.transpose() * L_inv_HP;
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  subtract_gram_symmetric(P_, L_inv_HP);
   // Post-fit DD phase residuals, normalised by their measurement sigma: the worst one is reported.
   post_fit = PostFit{};
   for (Eigen::Index a = 0; a < m; ++a) {
     const DdRow& row = rows[static_cast<std::size_t>(a)];
     if (!row.phase) continue;
-    double h_dx = row.h_pos.dot(dx.head<3>());
-    for (int k = 0; k < row.num_entries; ++k) {
-      h_dx += row.entries[static_cast<std::size_t>(k)].second * dx[row.entries[static_cast<std::size_t>(k)].first];
-    }
-    const double normalised = std::abs(v[a] - h_dx) / std::sqrt(R(a, a));
+    const double normalised = std::abs(v[a] - row.dot(dx)) / std::sqrt(measurement_covariance(a, a));
     if (normalised > post_fit.worst_normalised) {
       post_fit.worst_normalised = normalised;
       post_fit.worst_sd = row.sd;
