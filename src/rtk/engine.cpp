@@ -102,28 +102,35 @@ struct DdRow {
   }
 };
 
-// Dense kernels of the Kalman update, for the sizes of RTK (tens of states and measurements), where Eigen's blocked
-// general-purpose routines spend more on packing and blocking than on arithmetic. Column major throughout: every
-// inner loop runs down a contiguous column.
+// The Kalman update, for the sizes of RTK (tens of states and rows). Column major throughout; the kernels below are
+// plain loops and matrix-vector products because Eigen's blocked matrix-matrix routines spend more on packing than
+// on arithmetic at these sizes.
 
 /// In-place Cholesky factorisation A = L L^T of a symmetric positive definite m x m matrix given by its lower
 /// triangle; L overwrites the lower triangle, the strict upper triangle is neither read nor written. False if A is
 /// not positive definite.
 bool cholesky_lower_in_place(Eigen::MatrixXd& A) {
   const Eigen::Index m = A.rows();
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const double pivot = A(k, k);
-    if (!(pivot > 0.0)) return false;
-    const double l_kk = std::sqrt(pivot);
-    A(k, k) = l_kk;
-    A.col(k).tail(m - k - 1) /= l_kk;
-    for (Eigen::Index j = k + 1; j < m; ++j) A.col(j).tail(m - j) -= A(j, k) * A.col(k).tail(m - j);
+  double* a = A.data();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    // Left looking: column j minus the contributions of the columns already factorised, then scaled.
+    double* a_j = a + j * m;
+    for (Eigen::Index k = 0; k < j; ++k) {
+      const double* a_k = a + k * m;
+      const double l_jk = a_k[j];
+      for (Eigen::Index i = j; i < m; ++i) a_j[i] -= l_jk * a_k[i];
+    }
+    if (!(a_j[j] > 0.0)) return false;
+    const double l_jj = std::sqrt(a_j[j]);
+    a_j[j] = l_jj;
+    for (Eigen::Index i = j + 1; i < m; ++i) a_j[i] /= l_jj;
   }
   return true;
 }
 
-/// Solves L Y = B in place for Y (L lower triangular m x m, stored in the lower triangle; B m x n).
-void solve_lower_in_place(const Eigen::MatrixXd& L, Eigen::MatrixXd& B) {
+/// B <- L^-1 B in place (L lower triangular m x m, in the lower triangle of L; B m x k).
+template <typename Derived>
+void solve_lower_in_place(const Eigen::MatrixXd& L, Eigen::MatrixBase<Derived>& B) {
   const Eigen::Index m = L.rows();
   for (Eigen::Index j = 0; j < B.cols(); ++j) {
     auto b = B.col(j);
@@ -135,17 +142,120 @@ void solve_lower_in_place(const Eigen::MatrixXd& L, Eigen::MatrixXd& B) {
   }
 }
 
-/// P <- sym(P) - Y^T Y for an n x n P and an m x n Y, where sym(P) = (P + P^T) / 2 (P itself when symmetric): the
-/// lower triangle from dot products of columns of Y, mirrored, so that P is exactly symmetric afterwards.
-void subtract_gram_symmetric(Eigen::MatrixXd& P, const Eigen::MatrixXd& Y) {
+/// X <- X L^-T in place (X n x m, L lower triangular m x m): column k of the result is
+/// (X_k - sum_{j<k} L_kj X_j) / L_kk, one matrix-vector product per column.
+void solve_transposed_lower_from_right_in_place(const Eigen::MatrixXd& L, Eigen::MatrixXd& X) {
+  for (Eigen::Index k = 0; k < X.cols(); ++k) {
+    if (k > 0) X.col(k).noalias() -= X.leftCols(k) * L.row(k).head(k).transpose();
+    X.col(k) /= L(k, k);
+  }
+}
+
+/// P <- sym(P) - U V^T for an n x n P with U V^T symmetric (U, V n x r), where sym(P) = (P + P^T) / 2 (P itself when
+/// symmetric): computed on the lower triangle, one matrix-vector product per column, and mirrored, so that P is
+/// exactly symmetric afterwards.
+void subtract_symmetric_product(Eigen::MatrixXd& P, const Eigen::MatrixXd& U, const Eigen::MatrixXd& V) {
   const Eigen::Index n = P.rows();
   for (Eigen::Index j = 0; j < n; ++j) {
-    for (Eigen::Index i = j; i < n; ++i) {
-      const double p_ij = 0.5 * (P(i, j) + P(j, i)) - Y.col(i).dot(Y.col(j));
-      P(i, j) = p_ij;
-      P(j, i) = p_ij;
+    double* p_j = P.col(j).data();
+    for (Eigen::Index i = j + 1; i < n; ++i) p_j[i] = 0.5 * (p_j[i] + P(j, i));
+    for (Eigen::Index c = 0; c < U.cols(); ++c) {
+      const double v_jc = V(j, c);
+      const double* u_c = U.col(c).data();
+      for (Eigen::Index i = j; i < n; ++i) p_j[i] -= v_jc * u_c[i];
+    }
+    for (Eigen::Index i = j + 1; i < n; ++i) P(j, i) = p_j[i];
+  }
+}
+
+/// The states a block of DD rows touches, ascending, and the rows' Jacobian on them (H = H_J on J, zero elsewhere).
+struct CompressedJacobian {
+  std::vector<int> states;  // J
+  Eigen::MatrixXd H_J;      // rows x |J|
+};
+
+CompressedJacobian compress(const std::vector<const DdRow*>& rows) {
+  CompressedJacobian c;
+  c.states = {0, 1, 2};
+  for (const DdRow* row : rows) {
+    for (int k = 0; k < row->num_entries; ++k) c.states.push_back(row->entries[static_cast<std::size_t>(k)].first);
+  }
+  std::sort(c.states.begin(), c.states.end());
+  c.states.erase(std::unique(c.states.begin(), c.states.end()), c.states.end());
+  c.H_J = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(c.states.size()));
+  for (std::size_t a = 0; a < rows.size(); ++a) {
+    const auto r = static_cast<Eigen::Index>(a);
+    c.H_J.row(r).head<3>() = rows[a]->h_pos.transpose();
+    for (int k = 0; k < rows[a]->num_entries; ++k) {
+      const auto& [state, coefficient] = rows[a]->entries[static_cast<std::size_t>(k)];
+      const auto column = std::lower_bound(c.states.begin(), c.states.end(), state) - c.states.begin();
+      c.H_J(r, column) += coefficient;
     }
   }
+  return c;
+}
+
+/// The effect of one block of measurements on the state: x' = x + dx, P' = P - U V^T.
+struct KalmanStep {
+  Eigen::VectorXd dx;
+  Eigen::MatrixXd U;
+  Eigen::MatrixXd V;
+};
+
+/// Update with rows that touch few states (the DD code: position, and ionosphere states when estimated), in
+/// compressed form. With A = P E_J (the columns of P of the states J) and S = H_J P_JJ H_J^T + R = L L^T:
+///   G = L^-1 H_J,  W = G^T G = H_J^T S^-1 H_J,  dx = A G^T L^-1 v,  P' = P - (A W) A^T.
+/// R(a, b), a >= b, is the measurement covariance. nullopt if S is not positive definite.
+template <typename Covariance>
+std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P, const std::vector<const DdRow*>& rows,
+                                            Eigen::VectorXd v, const Covariance& R) {
+  const CompressedJacobian c = compress(rows);
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  const auto q = static_cast<Eigen::Index>(c.states.size());
+  KalmanStep step;
+  step.V.resize(P.rows(), q);  // A
+  for (Eigen::Index j = 0; j < q; ++j) step.V.col(j) = P.col(c.states[static_cast<std::size_t>(j)]);
+  Eigen::MatrixXd P_JJ(q, q);
+  for (Eigen::Index i = 0; i < q; ++i) P_JJ.row(i) = step.V.row(c.states[static_cast<std::size_t>(i)]);
+  const Eigen::MatrixXd H_P_JJ = c.H_J.lazyProduct(P_JJ);
+  Eigen::MatrixXd S(m, m);
+  for (Eigen::Index b = 0; b < m; ++b) {
+    for (Eigen::Index a = b; a < m; ++a) S(a, b) = H_P_JJ.row(a).dot(c.H_J.row(b)) + R(a, b);
+  }
+  if (!cholesky_lower_in_place(S)) return std::nullopt;
+  Eigen::MatrixXd G = c.H_J;
+  solve_lower_in_place(S, G);
+  solve_lower_in_place(S, v);
+  step.dx = step.V * (G.transpose() * v);
+  step.U = step.V.lazyProduct(G.transpose().lazyProduct(G));
+  return step;
+}
+
+/// Update with rows that touch most states (the DD phase), at the covariance P - U_prior V_prior^T of a preceding
+/// step that is not applied yet. With X = P H^T (from the sparse rows) and S = H X + R = L L^T:
+///   dx = (X L^-T) L^-1 v,  P' = P - (X L^-T) (X L^-T)^T.
+/// R(a, b), a >= b, is the measurement covariance. nullopt if S is not positive definite.
+template <typename Covariance>
+std::optional<KalmanStep> dense_update(const Eigen::MatrixXd& P, const KalmanStep& prior,
+                                       const std::vector<const DdRow*>& rows, Eigen::VectorXd v, const Covariance& R) {
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  KalmanStep step;
+  step.U.resize(P.rows(), m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    const DdRow& row = *rows[static_cast<std::size_t>(a)];
+    row.covariance_times(P, step.U.col(a));
+    for (Eigen::Index j = 0; j < prior.V.cols(); ++j) step.U.col(a) -= row.dot(prior.V.col(j)) * prior.U.col(j);
+  }
+  Eigen::MatrixXd S(m, m);
+  for (Eigen::Index b = 0; b < m; ++b) {
+    for (Eigen::Index a = b; a < m; ++a) S(a, b) = rows[static_cast<std::size_t>(a)]->dot(step.U.col(b)) + R(a, b);
+  }
+  if (!cholesky_lower_in_place(S)) return std::nullopt;
+  solve_transposed_lower_from_right_in_place(S, step.U);
+  solve_lower_in_place(S, v);
+  step.dx = step.U * v;
+  step.V = step.U;
+  return step;
 }
 
 }  // namespace
@@ -414,57 +524,63 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
     }
   }
   if (rows.empty()) return 0;
-  const auto m = static_cast<Eigen::Index>(rows.size());
-  // P H^T column by column (P h_a from columns of P, h_a sparse) and the innovations.
-  Eigen::MatrixXd PHt(n, m);
-  Eigen::VectorXd v(m);
-  for (Eigen::Index a = 0; a < m; ++a) {
-    const DdRow& row = rows[static_cast<std::size_t>(a)];
-    row.covariance_times(P_, PHt.col(a));
-    v[a] = row.innovation_m;
-  }
   // DD measurement covariance: the SD variances of s and of its reference on the diagonal; rows of one kind that
-  // share a reference are correlated through it.
+  // share a reference are correlated through it. Code and phase rows are uncorrelated.
   const auto sd_variance = [&](const DdRow& row, int i) {
     const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
     return row.phase ? sd.phase_variance_m2 : sd.code_variance_m2;
   };
-  const auto measurement_covariance = [&](Eigen::Index a, Eigen::Index b) {
-    const DdRow& ra = rows[static_cast<std::size_t>(a)];
-    const DdRow& rb = rows[static_cast<std::size_t>(b)];
-    if (a == b) return sd_variance(ra, ra.sd) + sd_variance(ra, ra.reference);
+  const auto covariance = [&](const DdRow& ra, const DdRow& rb) {
+    if (&ra == &rb) return sd_variance(ra, ra.sd) + sd_variance(ra, ra.reference);
     return rb.phase == ra.phase && rb.reference == ra.reference ? sd_variance(ra, ra.reference) : 0.0;
   };
-  // S = H P H^T + R (lower triangle), factorised in place: S = L L^T.
-  Eigen::MatrixXd S(m, m);
-  for (Eigen::Index b = 0; b < m; ++b) {
-    for (Eigen::Index a = b; a < m; ++a) {
-      S(a, b) = rows[static_cast<std::size_t>(a)].dot(PHt.col(b)) + measurement_covariance(a, b);
-    }
+  // R being block diagonal, the update is two sequential ones, the same as the joint update in exact arithmetic:
+  // the code rows, which touch only the position (and ionosphere states), in compressed form, then the phase rows at
+  // the code-updated covariance. Neither is applied before both factorisations have succeeded.
+  std::vector<const DdRow*> code_rows;
+  std::vector<const DdRow*> phase_rows;
+  for (const DdRow& row : rows) (row.phase ? phase_rows : code_rows).push_back(&row);
+  const auto block_covariance = [&](const std::vector<const DdRow*>& block) {
+    return [&covariance, &block](Eigen::Index a, Eigen::Index b) {
+      return covariance(*block[static_cast<std::size_t>(a)], *block[static_cast<std::size_t>(b)]);
+    };
+  };
+  const auto innovations = [](const std::vector<const DdRow*>& block, const Eigen::VectorXd& dx) {
+    Eigen::VectorXd v(static_cast<Eigen::Index>(block.size()));
+    for (std::size_t a = 0; a < block.size(); ++a)
+      v[static_cast<Eigen::Index>(a)] = block[a]->innovation_m - block[a]->dot(dx);
+    return v;
+  };
+  KalmanStep code_step{Eigen::VectorXd::Zero(n), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(n, 0)};
+  if (!code_rows.empty()) {
+    auto step = compressed_update(P_, code_rows, innovations(code_rows, code_step.dx), block_covariance(code_rows));
+    if (!step) return 0;
+    code_step = std::move(*step);
   }
-  if (!cholesky_lower_in_place(S)) return 0;
-  // Kalman update with K = P H^T S^-1:  dx = (L^-1 H P)^T (L^-1 v),  P' = P - (L^-1 H P)^T (L^-1 H P).
-  Eigen::MatrixXd L_inv_HP = PHt.transpose();
-  solve_lower_in_place(S, L_inv_HP);
-  Eigen::VectorXd L_inv_v = v;
-  S.triangularView<Eigen::Lower>().solveInPlace(L_inv_v);
-  const Eigen::VectorXd dx = L_inv_HP.transpose() * L_inv_v;
+  KalmanStep phase_step{Eigen::VectorXd::Zero(n), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(n, 0)};
+  if (!phase_rows.empty()) {
+    auto step =
+        dense_update(P_, code_step, phase_rows, innovations(phase_rows, code_step.dx), block_covariance(phase_rows));
+    if (!step) return 0;
+    phase_step = std::move(*step);
+  }
+  const Eigen::VectorXd dx = code_step.dx + phase_step.dx;
   x_ += dx;
-  subtract_gram_symmetric(P_, L_inv_HP);
+  Eigen::MatrixXd U(n, code_step.U.cols() + phase_step.U.cols());
+  Eigen::MatrixXd V(n, U.cols());
+  U << code_step.U, phase_step.U;
+  V << code_step.V, phase_step.V;
+  subtract_symmetric_product(P_, U, V);
   // Post-fit DD phase residuals, normalised by their measurement sigma: the worst one is reported.
   post_fit = PostFit{};
-  for (Eigen::Index a = 0; a < m; ++a) {
-    const DdRow& row = rows[static_cast<std::size_t>(a)];
-    if (!row.phase) continue;
-    const double normalised = std::abs(v[a] - row.dot(dx)) / std::sqrt(measurement_covariance(a, a));
+  for (const DdRow* row : phase_rows) {
+    const double normalised = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
     if (normalised > post_fit.worst_normalised) {
       post_fit.worst_normalised = normalised;
-      post_fit.worst_sd = row.sd;
+      post_fit.worst_sd = row->sd;
     }
   }
-  int phase_rows = 0;
-  for (const DdRow& r : rows) phase_rows += r.phase ? 1 : 0;
-  return phase_rows;
+  return static_cast<int>(phase_rows.size());
 }
 
 namespace {
