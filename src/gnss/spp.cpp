@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <string_view>
 
@@ -89,7 +90,7 @@ int clock_index(Constellation system, const SppOptions& o) {
 }
 
 std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const EphemerisStore& eph,
-                                              const SppOptions& options) {
+                                              const SppOptions& options, EpochSatelliteStates& states) {
   std::vector<Measurement> out;
   out.reserve(epoch.sats.size());
   for (const core::SatelliteObs& sat_obs : epoch.sats) {
@@ -98,7 +99,7 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
     const core::SignalObs* signal = select_signal(sat_obs);
     if (signal == nullptr) continue;
     const bool with_velocity = core::has_value(signal->doppler_hz);  // satellite velocity serves Doppler only
-    const auto state = eph.state_at_reception(sat_obs.sat, epoch.time, signal->pseudorange_m, nullptr, with_velocity);
+    const auto state = states.at_reception(sat_obs.sat, signal->pseudorange_m, with_velocity);
     if (!state) continue;
     const int channel =
         sat_obs.sat.system == Constellation::Glonass ? eph.glonass_channel(sat_obs.sat.prn) : core::kNoGlonassChannel;
@@ -316,8 +317,11 @@ std::string SppOptions::validate() const {
 }
 
 Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides, const SppOptions& options,
-                              const std::optional<Eigen::Vector3d>& initial_p_E_m) {
-  const std::vector<Measurement> ms = prepare_measurements(epoch, ephemerides, options);
+                              const std::optional<Eigen::Vector3d>& initial_p_E_m, EpochSatelliteStates* states) {
+  assert(states == nullptr || (states->receive_time() == epoch.time && &states->ephemerides() == &ephemerides));
+  std::optional<EpochSatelliteStates> own_states;
+  if (states == nullptr) states = &own_states.emplace(ephemerides, epoch.time);
+  const std::vector<Measurement> ms = prepare_measurements(epoch, ephemerides, options, *states);
   if (ms.size() < 4) {
     return Error{"too few satellites with pseudorange and ephemeris: " + std::to_string(ms.size())};
   }

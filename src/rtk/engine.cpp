@@ -29,10 +29,10 @@ struct ZeroDiff {
   double elevation_rad = 0.0;
 };
 
-ZeroDiff zero_difference(const gnss::EphemerisStore& eph, const SatelliteId sat, const core::GpsTime& t_rx,
-                         double pseudorange_m, const Eigen::Vector3d& p_E, const core::Geodetic& g, bool troposphere) {
+ZeroDiff zero_difference(gnss::EpochSatelliteStates& states, const SatelliteId sat, double pseudorange_m,
+                         const Eigen::Vector3d& p_E, const core::Geodetic& g, bool troposphere) {
   ZeroDiff z;
-  const auto state = eph.state_at_reception(sat, t_rx, pseudorange_m, nullptr, false);
+  const auto state = states.at_reception(sat, pseudorange_m, false);
   if (!state) return z;
   const double range_m = gnss::geometric_range_m(state->p_E_m, p_E, &z.los_E);
   const core::AzEl azel = core::azimuth_elevation(p_E, g, state->p_E_m);
@@ -696,7 +696,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
 }
 
 Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
-  auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_);
+  // The rover's satellite states are computed once, for the single-point solution, and reused by the zero
+  // differences.
+  gnss::EpochSatelliteStates rover_states(eph_, rover.time);
+  auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_, &rover_states);
   if (!spp) return spp.error();
   last_spp_p_E_m_ = spp->p_E_m;
 
@@ -727,7 +730,7 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
   const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
   detect_slips(rover_obs, base_obs);
-  std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs);
+  std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs, rover_states);
   update_ambiguities(sds, rover.time);
   out.num_dd_measurements = measurement_update(sds, out.rejected);
   if (out.num_dd_measurements == 0) {
@@ -747,11 +750,13 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
 }
 
 std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables& rover_obs,
-                                                      const ReceiverObservables& base_obs) const {
+                                                      const ReceiverObservables& base_obs,
+                                                      gnss::EpochSatelliteStates& rover_states) const {
   const Eigen::Vector3d p_E_u = x_.head<3>();
   const core::Geodetic g_u = core::ecef_to_geodetic(p_E_u);
   const core::Geodetic g_b = core::ecef_to_geodetic(p_E_base_m_);
   const bool tropo = options_.troposphere_saastamoinen;
+  gnss::EpochSatelliteStates base_states(eph_, base_obs.time);
   std::vector<SingleDiff> sds;
   sds.reserve(rover_obs.signals.size());
   SatelliteId current{};
@@ -765,9 +770,8 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
       current = r.sat;
       const double pr_r = any_pseudorange(rover_obs, r.sat);
       const double pr_b = any_pseudorange(base_obs, r.sat);
-      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover_obs.time, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
-      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base_obs.time, pr_b, p_E_base_m_, g_b, tropo)
-                                 : ZeroDiff{};
+      zr = core::has_value(pr_r) ? zero_difference(rover_states, r.sat, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
+      zb = core::has_value(pr_b) ? zero_difference(base_states, r.sat, pr_b, p_E_base_m_, g_b, tropo) : ZeroDiff{};
     }
     if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
     SingleDiff sd;

@@ -51,6 +51,7 @@
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
 #include "canyon/gnss/ephemeris.hpp"
+#include "canyon/gnss/satellite_states.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/rtk/cycle_slip.hpp"
 #include "canyon/rtk/observables.hpp"
@@ -130,8 +131,10 @@ class RtkEngine {
     core::GpsTime last_seen;
   };
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
+  /// `rover_states`: the rover epoch's satellite states (shared with its single-point solution).
   [[nodiscard]] std::vector<SingleDiff> single_differences(const ReceiverObservables& rover,
-                                                           const ReceiverObservables& base) const;
+                                                           const ReceiverObservables& base,
+                                                           gnss::EpochSatelliteStates& rover_states) const;
   /// Runs both receivers' slip detectors and re-initialises the ambiguities that slipped; the base detector sees
   /// each base epoch once (a base slower than the rover repeats its epochs).
   void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
