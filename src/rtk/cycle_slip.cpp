@@ -132,11 +132,12 @@ void CycleSlipDetector::test_continuity(std::vector<Current>& signals, core::Gps
 
 void CycleSlipDetector::test_geometry_free(std::vector<Current>& signals, core::GpsTime time) const {
   // Signals are sorted by (satellite, frequency): walk satellite by satellite.
+  std::vector<std::size_t> usable;  // per satellite, reused
   for (std::size_t first = 0; first < signals.size();) {
     std::size_t end = first;
     while (end < signals.size() && signals[end].key.first == signals[first].key.first) ++end;
     // Frequencies with a usable history (not new, no outage); the lowest is the reference.
-    std::vector<std::size_t> usable;
+    usable.clear();
     for (std::size_t i = first; i < end; ++i) {
       const Current& c = signals[i];
       if (c.previous != nullptr && !(c.event && c.event->cause == SlipCause::Outage)) usable.push_back(i);

@@ -275,7 +275,8 @@ struct SingleDiff {
   std::uint8_t lli = 0;     // rover | base loss-of-lock bits
   int ambiguity = -1;       // state index of N_sd, -1 if none
   int iono = -1;            // state index of the satellite's SD ionosphere, -1 if not estimated
-  double iono_scale = 1.0;  // (f_1 / f)^2: the delay on this frequency per metre of first-frequency delay
+  double iono_scale = 1.0;  // (f_1 / f)^2: the delay on this frequency per metre of first-frequency delay (when
+                            // the ionosphere is estimated)
   bool fixable = false;
 };
 
@@ -779,7 +780,9 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
     sd.frequency = r.frequency;
     sd.group = static_cast<int>(r.sat.system) * kMaxFrequencies + r.frequency;
     sd.wavelength_m = r.wavelength_m;
-    sd.iono_scale = std::pow(r.wavelength_m / first_wavelength_m(eph_, r.sat), 2);
+    if (options_.ionosphere == IonosphereModel::Estimate) {
+      sd.iono_scale = std::pow(r.wavelength_m / first_wavelength_m(eph_, r.sat), 2);
+    }
     sd.lli = static_cast<std::uint8_t>(r.lli | b->lli);
     const double model_m = zr.model_m - zb.model_m;
     if (core::has_value(r.carrier_phase_cyc) && core::has_value(b->carrier_phase_cyc) &&
