@@ -100,8 +100,9 @@ std::vector<CycleSlipDetector::Current> CycleSlipDetector::collect(const Receive
     c.lli = s.lli;
     out.push_back(c);
   }
-  // Sorted by pair, first occurrence of a duplicate kept.
-  std::stable_sort(out.begin(), out.end(), [](const Current& a, const Current& b) { return a.key < b.key; });
+  // Sorted by pair, first occurrence of a duplicate kept (ReceiverObservables come sorted: nothing to move then).
+  const auto by_key = [](const Current& a, const Current& b) { return a.key < b.key; };
+  if (!std::is_sorted(out.begin(), out.end(), by_key)) std::stable_sort(out.begin(), out.end(), by_key);
   out.erase(std::unique(out.begin(), out.end(), [](const Current& a, const Current& b) { return a.key == b.key; }),
             out.end());
   for (Current& c : out) {
