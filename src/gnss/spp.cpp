@@ -148,10 +148,12 @@ Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>
     double iono_m = 0.0;
     double tropo_m = 0.0;
     if (have_position) {
-      const core::AzEl azel = core::azimuth_elevation_from_enu(R_NE * los_E);
-      if (azel.elevation_rad < options.elevation_mask_rad) continue;
-      sin_el = std::max(std::sin(azel.elevation_rad), kMinSinElevation);
+      const Eigen::Vector3d los_N = R_NE * los_E;
+      const double elevation_rad = core::elevation_from_enu(los_N);  // the azimuth only for a refresh
+      if (elevation_rad < options.elevation_mask_rad) continue;
+      sin_el = std::max(std::sin(elevation_rad), kMinSinElevation);
       if ((m.atmosphere_p_E_m - p_E).squaredNorm() > kAtmosphereRefreshM * kAtmosphereRefreshM) {
+        const core::AzEl azel = core::azimuth_elevation_from_enu(los_N);
         m.iono_m = options.ionosphere_klobuchar ? m.iono_scale * klobuchar_delay_m(t, rcv, azel, klob) : 0.0;
         m.tropo_m = options.troposphere_saastamoinen ? saastamoinen_delay_m(rcv, azel.elevation_rad) : 0.0;
         m.atmosphere_p_E_m = p_E;

@@ -29,16 +29,25 @@ struct ZeroDiff {
   double elevation_rad = 0.0;
 };
 
+/// A receiver's position with its geodetic coordinates and ENU rotation, for the zero differences of an epoch.
+struct ReceiverGeometry {
+  Eigen::Vector3d p_E_m;
+  core::Geodetic g;
+  Eigen::Matrix3d R_NE;
+
+  explicit ReceiverGeometry(const Eigen::Vector3d& p_E)
+      : p_E_m(p_E), g(core::ecef_to_geodetic(p_E)), R_NE(core::rotation_enu_from_ecef(g)) {}
+};
+
 ZeroDiff zero_difference(gnss::EpochSatelliteStates& states, const SatelliteId sat, double pseudorange_m,
-                         const Eigen::Vector3d& p_E, const core::Geodetic& g, bool troposphere) {
+                         const ReceiverGeometry& receiver, bool troposphere) {
   ZeroDiff z;
   const auto state = states.at_reception(sat, pseudorange_m, false);
   if (!state) return z;
-  const double range_m = gnss::geometric_range_m(state->p_E_m, p_E, &z.los_E);
-  const core::AzEl azel = core::azimuth_elevation(p_E, g, state->p_E_m);
-  z.elevation_rad = azel.elevation_rad;
+  const double range_m = gnss::geometric_range_m(state->p_E_m, receiver.p_E_m, &z.los_E);
+  z.elevation_rad = core::elevation_rad(receiver.p_E_m, receiver.g, receiver.R_NE, state->p_E_m);
   z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s +
-              (troposphere ? gnss::saastamoinen_delay_m(g, azel.elevation_rad) : 0.0);
+              (troposphere ? gnss::saastamoinen_delay_m(receiver.g, z.elevation_rad) : 0.0);
   z.valid = true;
   return z;
 }
@@ -753,9 +762,8 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
 std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables& rover_obs,
                                                       const ReceiverObservables& base_obs,
                                                       gnss::EpochSatelliteStates& rover_states) const {
-  const Eigen::Vector3d p_E_u = x_.head<3>();
-  const core::Geodetic g_u = core::ecef_to_geodetic(p_E_u);
-  const core::Geodetic g_b = core::ecef_to_geodetic(p_E_base_m_);
+  const ReceiverGeometry rover(x_.head<3>());
+  const ReceiverGeometry base(p_E_base_m_);
   const bool tropo = options_.troposphere_saastamoinen;
   gnss::EpochSatelliteStates base_states(eph_, base_obs.time);
   std::vector<SingleDiff> sds;
@@ -771,8 +779,8 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
       current = r.sat;
       const double pr_r = any_pseudorange(rover_obs, r.sat);
       const double pr_b = any_pseudorange(base_obs, r.sat);
-      zr = core::has_value(pr_r) ? zero_difference(rover_states, r.sat, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
-      zb = core::has_value(pr_b) ? zero_difference(base_states, r.sat, pr_b, p_E_base_m_, g_b, tropo) : ZeroDiff{};
+      zr = core::has_value(pr_r) ? zero_difference(rover_states, r.sat, pr_r, rover, tropo) : ZeroDiff{};
+      zb = core::has_value(pr_b) ? zero_difference(base_states, r.sat, pr_b, base, tropo) : ZeroDiff{};
     }
     if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
     SingleDiff sd;

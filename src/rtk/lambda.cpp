@@ -96,13 +96,14 @@ struct ElementaryOperation {
 Eigen::MatrixXd back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm,
                                const Eigen::MatrixXd& z) {
   const Eigen::Index m = z.cols();
-  Eigen::MatrixXd z_T = z.transpose();          // column i holds entry i of every candidate, contiguous
+  Eigen::MatrixXd z_T = z.transpose();  // column i holds entry i of every candidate, contiguous
+  double* const entries = z_T.data();
   for (std::size_t k = log.size(); k-- > 0;) {  // newest first (no ranges: clang-tidy 14 cannot parse them)
     const ElementaryOperation& op = log[k];
-    double* z_k = z_T.col(op.k).data();
-    double* z_i = z_T.col(op.i).data();
+    double* z_k = entries + op.k * m;
+    double* z_i = entries + op.i * m;
     if (op.mu == 0.0) {
-      std::swap_ranges(z_k, z_k + m, z_i);
+      for (Eigen::Index j = 0; j < m; ++j) std::swap(z_k[j], z_i[j]);
     } else {
       for (Eigen::Index j = 0; j < m; ++j) z_k[j] += op.mu * z_i[j];
     }
