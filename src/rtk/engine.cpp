@@ -122,9 +122,19 @@ bool cholesky_lower_in_place(Eigen::MatrixXd& A) {
   const Eigen::Index m = A.rows();
   double* a = A.data();
   for (Eigen::Index j = 0; j < m; ++j) {
-    // Left looking: column j minus the contributions of the columns already factorised, then scaled.
+    // Left looking: column j minus the contributions of the columns already factorised, four at a time (one pass
+    // over column j per four), then scaled.
     double* a_j = a + j * m;
-    for (Eigen::Index k = 0; k < j; ++k) {
+    Eigen::Index k = 0;
+    for (; k + 4 <= j; k += 4) {
+      const double* a_0 = a + k * m;
+      const double* a_1 = a_0 + m;
+      const double* a_2 = a_1 + m;
+      const double* a_3 = a_2 + m;
+      const double l_0 = a_0[j], l_1 = a_1[j], l_2 = a_2[j], l_3 = a_3[j];
+      for (Eigen::Index i = j; i < m; ++i) a_j[i] -= (l_0 * a_0[i] + l_1 * a_1[i]) + (l_2 * a_2[i] + l_3 * a_3[i]);
+    }
+    for (; k < j; ++k) {
       const double* a_k = a + k * m;
       const double l_jk = a_k[j];
       for (Eigen::Index i = j; i < m; ++i) a_j[i] -= l_jk * a_k[i];
@@ -165,10 +175,20 @@ void solve_transposed_lower_from_right_in_place(const Eigen::MatrixXd& L, Eigen:
 /// exactly symmetric afterwards.
 void subtract_symmetric_product(Eigen::MatrixXd& P, const Eigen::MatrixXd& U, const Eigen::MatrixXd& V) {
   const Eigen::Index n = P.rows();
+  const Eigen::Index r = U.cols();
   for (Eigen::Index j = 0; j < n; ++j) {
     double* p_j = P.col(j).data();
     for (Eigen::Index i = j + 1; i < n; ++i) p_j[i] = 0.5 * (p_j[i] + P(j, i));
-    for (Eigen::Index c = 0; c < U.cols(); ++c) {
+    Eigen::Index c = 0;
+    for (; c + 4 <= r; c += 4) {  // four columns of U per pass over column j of P
+      const double* u_0 = U.col(c).data();
+      const double* u_1 = U.col(c + 1).data();
+      const double* u_2 = U.col(c + 2).data();
+      const double* u_3 = U.col(c + 3).data();
+      const double v_0 = V(j, c), v_1 = V(j, c + 1), v_2 = V(j, c + 2), v_3 = V(j, c + 3);
+      for (Eigen::Index i = j; i < n; ++i) p_j[i] -= (v_0 * u_0[i] + v_1 * u_1[i]) + (v_2 * u_2[i] + v_3 * u_3[i]);
+    }
+    for (; c < r; ++c) {
       const double v_jc = V(j, c);
       const double* u_c = U.col(c).data();
       for (Eigen::Index i = j; i < n; ++i) p_j[i] -= v_jc * u_c[i];
