@@ -355,27 +355,44 @@ int RtkEngine::ambiguity_index(const AmbiguityKey& key) const {
   return it == ambiguity_keys_.end() ? -1 : num_kinematic_states() + static_cast<int>(it - ambiguity_keys_.begin());
 }
 
+void RtkEngine::add_states(const std::vector<NewState>& states) {
+  if (states.empty()) return;
+  const Eigen::Index n = x_.size();
+  const auto added = static_cast<Eigen::Index>(states.size());
+  // One new x and P (a copy of the old block, zeros, the new variances) rather than one resize per state.
+  Eigen::VectorXd x(n + added);
+  x.head(n) = x_;
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n + added, n + added);
+  P.topLeftCorner(n, n) = P_;
+  for (Eigen::Index i = 0; i < added; ++i) {
+    const NewState& state = states[static_cast<std::size_t>(i)];
+    x[n + i] = state.value;
+    P(n + i, n + i) = state.variance;
+    ambiguity_keys_.push_back(state.key);
+  }
+  x_.swap(x);
+  P_.swap(P);
+}
+
 void RtkEngine::add_ambiguity(const AmbiguityKey& key, double value, double variance) {
-  const auto n = x_.size();
-  x_.conservativeResize(n + 1);
-  x_[n] = value;
-  P_.conservativeResize(n + 1, n + 1);
-  P_.row(n).setZero();
-  P_.col(n).setZero();
-  P_(n, n) = variance;
-  ambiguity_keys_.push_back(key);
+  add_states({NewState{key, value, variance}});
 }
 
 void RtkEngine::remove_ambiguity(const AmbiguityKey& key) {
   const int index = ambiguity_index(key);
   if (index < 0) return;
+  // x and P without the state: one copy into new storage (four blocks of P), no shifting in place.
   const auto n = x_.size();
   const auto tail = n - index - 1;
-  x_.segment(index, tail) = x_.tail(tail).eval();
-  x_.conservativeResize(n - 1);
-  P_.block(index, 0, tail, n) = P_.bottomRows(tail).eval();
-  P_.block(0, index, n, tail) = P_.rightCols(tail).eval();
-  P_.conservativeResize(n - 1, n - 1);
+  Eigen::VectorXd x(n - 1);
+  x << x_.head(index), x_.tail(tail);
+  Eigen::MatrixXd P(n - 1, n - 1);
+  P.topLeftCorner(index, index) = P_.topLeftCorner(index, index);
+  P.topRightCorner(index, tail) = P_.topRightCorner(index, tail);
+  P.bottomLeftCorner(tail, index) = P_.bottomLeftCorner(tail, index);
+  P.bottomRightCorner(tail, tail) = P_.bottomRightCorner(tail, tail);
+  x_.swap(x);
+  P_.swap(P);
   ambiguity_keys_.erase(ambiguity_keys_.begin() + (index - num_kinematic_states()));
   ambiguity_info_.erase(key);
 }
@@ -440,13 +457,19 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     if (t - info.last_seen > options_.max_outage_s) stale.push_back(key);
   }
   for (const auto& key : stale) remove_ambiguity(key);
+  // New states are collected and appended at once (in the order found, as one by one).
+  std::vector<NewState> new_states;
+  const auto has_state = [&](const AmbiguityKey& key) {
+    return ambiguity_index(key) >= 0 ||
+           std::any_of(new_states.begin(), new_states.end(), [&](const NewState& s) { return s.key == key; });
+  };
   for (SingleDiff& sd : sds) {
     if (!core::has_value(sd.phase_m)) continue;
     const AmbiguityKey key{sd.sat, sd.frequency};
-    if (ambiguity_index(key) < 0) {
+    if (!has_state(key)) {
       if (!core::has_value(sd.code_m)) continue;
       const double sigma = options_.initial_ambiguity_sigma_cyc;
-      add_ambiguity(key, (sd.phase_m - sd.code_m) / sd.wavelength_m, sigma * sigma);
+      new_states.push_back(NewState{key, (sd.phase_m - sd.code_m) / sd.wavelength_m, sigma * sigma});
       ambiguity_info_[key] = AmbiguityInfo{};
     }
     AmbiguityInfo& a = ambiguity_info_[key];
@@ -464,10 +487,11 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     const double sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, 0.001);
     for (const SingleDiff& sd : sds) {
       const AmbiguityKey key{sd.sat, kIonoKey};
-      if (ambiguity_index(key) < 0) add_ambiguity(key, 0.0, sigma_m * sigma_m);
+      if (!has_state(key)) new_states.push_back(NewState{key, 0.0, sigma_m * sigma_m});
       ambiguity_info_[key].last_seen = t;
     }
   }
+  add_states(new_states);
   for (SingleDiff& sd : sds) {
     sd.ambiguity = core::has_value(sd.phase_m) ? ambiguity_index({sd.sat, sd.frequency}) : -1;
     sd.iono = ambiguity_index({sd.sat, kIonoKey});

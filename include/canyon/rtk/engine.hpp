@@ -139,6 +139,14 @@ class RtkEngine {
   /// each base epoch once (a base slower than the rover repeats its epochs).
   void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
   void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
+  /// A keyed state to append: initial value and variance, uncorrelated with the other states.
+  struct NewState {
+    AmbiguityKey key;
+    double value = 0.0;
+    double variance = 0.0;
+  };
+  /// Appends the states in order, with one resize of x and P for all of them.
+  void add_states(const std::vector<NewState>& states);
   /// EKF update with the DD code and phase, with post-fit rejection; returns the number of DD phase rows used.
   int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
   struct PostFit {
