@@ -65,15 +65,15 @@ Status check_symmetric(const Eigen::MatrixXd& Q, const char* who) {
 }
 
 /// std::round (to nearest, halves away from zero), bit for bit, without the library call that std::round is on
-/// x86-64 without SSE4.1 (it dominated the search and the reduction). For 0.5 <= |x| < 2^52, |x| + 0.5 is exact or
-/// (when it crosses a power of two, or for |x| < 1) rounds to a value with the same integer part, so truncating it
-/// is floor(|x| + 1/2); from 2^52 on every double is an integer.
+/// x86-64 without SSE4.1 (it dominated the search and the reduction). Below 2^52 the integer part of |x| fits an
+/// int64 and |x| minus it is exact; from 2^52 on every double is an integer.
 double round_half_away(double x) {
   constexpr double kAllIntegers = 4503599627370496.0;  // 2^52
   const double a = std::abs(x);
-  if (a < 0.5) return std::copysign(0.0, x);
-  if (!(a < kAllIntegers)) return x;  // integers, infinities and NaN round to themselves
-  return std::copysign(static_cast<double>(static_cast<std::int64_t>(a + 0.5)), x);
+  if (!(a < kAllIntegers)) return x;                       // integers, infinities and NaN round to themselves
+  const auto whole = static_cast<std::int64_t>(a);         // floor(|x|)
+  const double fraction = a - static_cast<double>(whole);  // exact
+  return std::copysign(static_cast<double>(whole + (fraction >= 0.5 ? 1 : 0)), x);
 }
 
 /// Round to nearest for a multiplier of an integer Gauss transformation; 0 when |x| <= 1/2 (already size-reduced),
