@@ -70,11 +70,26 @@ AzEl azimuth_elevation_from_enu(const Eigen::Vector3d& d_N) {
   return result;
 }
 
+double elevation_from_enu(const Eigen::Vector3d& d_N) {
+  return std::asin(std::clamp(d_N.normalized().z(), -1.0, 1.0));  // as in azimuth_elevation_from_enu
+}
+
+namespace {
+/// No position yet (the Earth's centre): every satellite at zenith.
+bool at_earth_centre(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv) {
+  return rcv.height_m <= -kWgs84SemiMajorM + 1.0 || p_E_rcv.norm() < 1.0;
+}
+}  // namespace
+
 AzEl azimuth_elevation(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv, const Eigen::Vector3d& p_E_sat) {
-  if (rcv.height_m <= -kWgs84SemiMajorM + 1.0 || p_E_rcv.norm() < 1.0) {
-    return AzEl{0.0, kPi / 2.0};
-  }
+  if (at_earth_centre(p_E_rcv, rcv)) return AzEl{0.0, kPi / 2.0};
   return azimuth_elevation_from_enu(ecef_to_enu(p_E_sat - p_E_rcv, rcv));
+}
+
+double elevation_rad(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv, const Eigen::Matrix3d& R_NE,
+                     const Eigen::Vector3d& p_E_sat) {
+  if (at_earth_centre(p_E_rcv, rcv)) return kPi / 2.0;
+  return elevation_from_enu(R_NE * (p_E_sat - p_E_rcv));
 }
 
 }  // namespace canyon::core

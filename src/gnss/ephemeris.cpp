@@ -161,18 +161,6 @@ double band_frequency_hz(Constellation system, char band) {
 
 }  // namespace
 
-EphemerisStore::EphemerisStore(core::NavigationData nav, EphemerisOptions options)
-    : nav_(std::move(nav)), options_(options) {
-  kepler_by_sat_.resize(core::kMaxSatellites);
-  glonass_by_sat_.resize(core::kMaxSatellites);
-  for (int i = 0; i < static_cast<int>(nav_.kepler.size()); ++i) {
-    if (nav_.kepler[i].sat.valid()) kepler_by_sat_[nav_.kepler[i].sat.index()].push_back(i);
-  }
-  for (int i = 0; i < static_cast<int>(nav_.glonass.size()); ++i) {
-    if (nav_.glonass[i].sat.valid()) glonass_by_sat_[nav_.glonass[i].sat.index()].push_back(i);
-  }
-}
-
 namespace {
 
 /// Health as it concerns canyon's signals. QZSS LNAV's health word has the L1C/B (formerly LEX) signal in its least
@@ -185,34 +173,47 @@ bool kepler_healthy(const core::KeplerEphemeris& e) {
 
 }  // namespace
 
+EphemerisStore::EphemerisStore(core::NavigationData nav, EphemerisOptions options)
+    : nav_(std::move(nav)), options_(options) {
+  kepler_by_sat_.resize(core::kMaxSatellites);
+  glonass_by_sat_.resize(core::kMaxSatellites);
+  for (int i = 0; i < static_cast<int>(nav_.kepler.size()); ++i) {
+    const core::KeplerEphemeris& e = nav_.kepler[i];
+    if (!e.sat.valid() || (!kepler_healthy(e) && !options_.use_unhealthy)) continue;
+    const double fit_s = e.fit_interval_h > 0.0 ? e.fit_interval_h * 3600.0 / 2.0 : 0.0;
+    kepler_by_sat_[e.sat.index()].push_back(
+        KeplerCandidate{e.toe, e.transmission_time, std::max(options_.max_age_kepler_s, fit_s), i, is_galileo_inav(e)});
+  }
+  for (int i = 0; i < static_cast<int>(nav_.glonass.size()); ++i) {
+    if (nav_.glonass[i].sat.valid()) glonass_by_sat_[nav_.glonass[i].sat.index()].push_back(i);
+  }
+}
+
 const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat, core::GpsTime t) const {
   if (!sat.valid() || sat.system == Constellation::Glonass) return nullptr;
   const bool galileo = sat.system == Constellation::Galileo;
-  const core::KeplerEphemeris* best = nullptr;
+  const KeplerCandidate* best = nullptr;
   double best_age_s = 0.0;
-  for (const int i : kepler_by_sat_[sat.index()]) {
-    const core::KeplerEphemeris& e = nav_.kepler[i];
-    if (!kepler_healthy(e) && !options_.use_unhealthy) continue;
+  for (const KeplerCandidate& c : kepler_by_sat_[sat.index()]) {  // usable health only
     // Galileo: only an ephemeris whose toe has passed (age of data > 0), the rule RTKLIB 2.4.3 applies; Galileo
     // toe is at the start of the record's validity, so a future toe means a record not broadcast yet.
-    if (galileo && !(e.toe < t)) continue;
-    const double age_s = std::abs(t - e.toe);
-    const double fit_s = e.fit_interval_h > 0.0 ? e.fit_interval_h * 3600.0 / 2.0 : 0.0;
-    if (age_s > std::max(options_.max_age_kepler_s, fit_s)) continue;
+    if (galileo && !(c.toe < t)) continue;
+    const double age_s = std::abs(t - c.toe);
+    if (age_s > c.max_age_s) continue;
     if (best != nullptr) {
       // Galileo: I/NAV is preferred to F/NAV whatever their ages (the I/NAV clock is referenced to E1/E5b, the
       // signals canyon pairs first).
-      if (galileo && is_galileo_inav(*best) != is_galileo_inav(e)) {
-        if (!is_galileo_inav(e)) continue;
-      } else if (age_s > best_age_s || (age_s == best_age_s && e.transmission_time < best->transmission_time)) {
+      if (galileo && best->galileo_inav != c.galileo_inav) {
+        if (!c.galileo_inav) continue;
+      } else if (age_s > best_age_s || (age_s == best_age_s && c.transmission_time < best->transmission_time)) {
         // Nearest toe; on equal distance, the most recently transmitted message.
         continue;
       }
     }
-    best = &e;
+    best = &c;
     best_age_s = age_s;
   }
-  return best;
+  return best != nullptr ? &nav_.kepler[static_cast<std::size_t>(best->index)] : nullptr;
 }
 
 const core::GlonassEphemeris* EphemerisStore::select_glonass(core::SatelliteId sat, core::GpsTime t) const {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <string_view>
 
@@ -89,7 +90,7 @@ int clock_index(Constellation system, const SppOptions& o) {
 }
 
 std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const EphemerisStore& eph,
-                                              const SppOptions& options) {
+                                              const SppOptions& options, EpochSatelliteStates& states) {
   std::vector<Measurement> out;
   out.reserve(epoch.sats.size());
   for (const core::SatelliteObs& sat_obs : epoch.sats) {
@@ -98,7 +99,7 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
     const core::SignalObs* signal = select_signal(sat_obs);
     if (signal == nullptr) continue;
     const bool with_velocity = core::has_value(signal->doppler_hz);  // satellite velocity serves Doppler only
-    const auto state = eph.state_at_reception(sat_obs.sat, epoch.time, signal->pseudorange_m, nullptr, with_velocity);
+    const auto state = states.at_reception(sat_obs.sat, signal->pseudorange_m, with_velocity);
     if (!state) continue;
     const int channel =
         sat_obs.sat.system == Constellation::Glonass ? eph.glonass_channel(sat_obs.sat.prn) : core::kNoGlonassChannel;
@@ -147,10 +148,12 @@ Linearised linearise(const std::vector<Measurement>& ms, const std::vector<bool>
     double iono_m = 0.0;
     double tropo_m = 0.0;
     if (have_position) {
-      const core::AzEl azel = core::azimuth_elevation_from_enu(R_NE * los_E);
-      if (azel.elevation_rad < options.elevation_mask_rad) continue;
-      sin_el = std::max(std::sin(azel.elevation_rad), kMinSinElevation);
+      const Eigen::Vector3d los_N = R_NE * los_E;
+      const double elevation_rad = core::elevation_from_enu(los_N);  // the azimuth only for a refresh
+      if (elevation_rad < options.elevation_mask_rad) continue;
+      sin_el = std::max(std::sin(elevation_rad), kMinSinElevation);
       if ((m.atmosphere_p_E_m - p_E).squaredNorm() > kAtmosphereRefreshM * kAtmosphereRefreshM) {
+        const core::AzEl azel = core::azimuth_elevation_from_enu(los_N);
         m.iono_m = options.ionosphere_klobuchar ? m.iono_scale * klobuchar_delay_m(t, rcv, azel, klob) : 0.0;
         m.tropo_m = options.troposphere_saastamoinen ? saastamoinen_delay_m(rcv, azel.elevation_rad) : 0.0;
         m.atmosphere_p_E_m = p_E;
@@ -316,8 +319,11 @@ std::string SppOptions::validate() const {
 }
 
 Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides, const SppOptions& options,
-                              const std::optional<Eigen::Vector3d>& initial_p_E_m) {
-  const std::vector<Measurement> ms = prepare_measurements(epoch, ephemerides, options);
+                              const std::optional<Eigen::Vector3d>& initial_p_E_m, EpochSatelliteStates* states) {
+  assert(states == nullptr || (states->receive_time() == epoch.time && &states->ephemerides() == &ephemerides));
+  std::optional<EpochSatelliteStates> own_states;
+  if (states == nullptr) states = &own_states.emplace(ephemerides, epoch.time);
+  const std::vector<Measurement> ms = prepare_measurements(epoch, ephemerides, options, *states);
   if (ms.size() < 4) {
     return Error{"too few satellites with pseudorange and ephemeris: " + std::to_string(ms.size())};
   }

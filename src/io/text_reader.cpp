@@ -174,9 +174,52 @@ std::optional<double> parse_simple_decimal(std::string_view text) {
   return negative ? -value : value;
 }
 
+/// One pass over the commonest form, [spaces][+-]digits[.digits][spaces] with at most 15 digits (every RINEX
+/// observation value): Blank, a Value computed exactly as parse_simple_decimal() does (an integer mantissa below
+/// 2^53 divided by a power of ten, correctly rounded), or Other (any other form, for the general path).
+struct PlainDecimal {
+  enum class Kind { Blank, Value, Other };
+  Kind kind = Kind::Other;
+  double value = 0.0;
+};
+
+PlainDecimal parse_plain_decimal(std::string_view text) {
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  while (p != end && *p == ' ') ++p;
+  if (p == end) return {PlainDecimal::Kind::Blank, 0.0};
+  const bool negative = *p == '-';
+  if (*p == '-' || *p == '+') ++p;
+  std::uint64_t mantissa = 0;
+  int digits = 0;
+  int fraction_digits = 0;
+  bool dot = false;
+  for (; p != end; ++p) {
+    const char c = *p;
+    if (c >= '0' && c <= '9') {
+      mantissa = mantissa * 10 + static_cast<std::uint64_t>(c - '0');
+      ++digits;
+      fraction_digits += dot ? 1 : 0;
+    } else if (c == '.' && !dot) {
+      dot = true;
+    } else {
+      break;
+    }
+  }
+  while (p != end && *p == ' ') ++p;
+  constexpr int kMaxPlainDigits = 15;  // mantissa < 10^15 < 2^53: exact
+  if (p != end || digits == 0 || digits > kMaxPlainDigits) return {};
+  double value = static_cast<double>(mantissa);
+  if (fraction_digits > 0) value /= kPow10[fraction_digits];
+  return {PlainDecimal::Kind::Value, negative ? -value : value};
+}
+
 }  // namespace
 
 std::optional<double> parse_double(std::string_view field, std::optional<double> blank_value) {
+  const PlainDecimal plain = parse_plain_decimal(field);
+  if (plain.kind == PlainDecimal::Kind::Value) return plain.value;
+  if (plain.kind == PlainDecimal::Kind::Blank) return blank_value;
   field = trim(field);
   if (field.empty()) return blank_value;
   if (const auto fast = parse_simple_decimal(field)) return fast;

@@ -100,8 +100,9 @@ std::vector<CycleSlipDetector::Current> CycleSlipDetector::collect(const Receive
     c.lli = s.lli;
     out.push_back(c);
   }
-  // Sorted by pair, first occurrence of a duplicate kept.
-  std::stable_sort(out.begin(), out.end(), [](const Current& a, const Current& b) { return a.key < b.key; });
+  // Sorted by pair, first occurrence of a duplicate kept (ReceiverObservables come sorted: nothing to move then).
+  const auto by_key = [](const Current& a, const Current& b) { return a.key < b.key; };
+  if (!std::is_sorted(out.begin(), out.end(), by_key)) std::stable_sort(out.begin(), out.end(), by_key);
   out.erase(std::unique(out.begin(), out.end(), [](const Current& a, const Current& b) { return a.key == b.key; }),
             out.end());
   for (Current& c : out) {
@@ -132,11 +133,12 @@ void CycleSlipDetector::test_continuity(std::vector<Current>& signals, core::Gps
 
 void CycleSlipDetector::test_geometry_free(std::vector<Current>& signals, core::GpsTime time) const {
   // Signals are sorted by (satellite, frequency): walk satellite by satellite.
+  std::vector<std::size_t> usable;  // per satellite, reused
   for (std::size_t first = 0; first < signals.size();) {
     std::size_t end = first;
     while (end < signals.size() && signals[end].key.first == signals[first].key.first) ++end;
     // Frequencies with a usable history (not new, no outage); the lowest is the reference.
-    std::vector<std::size_t> usable;
+    usable.clear();
     for (std::size_t i = first; i < end; ++i) {
       const Current& c = signals[i];
       if (c.previous != nullptr && !(c.event && c.event->cause == SlipCause::Outage)) usable.push_back(i);

@@ -31,16 +31,25 @@ struct ZeroDiff {
   double elevation_rad = 0.0;
 };
 
-ZeroDiff zero_difference(const gnss::EphemerisStore& eph, const SatelliteId sat, const core::GpsTime& t_rx,
-                         double pseudorange_m, const Eigen::Vector3d& p_E, const core::Geodetic& g, bool troposphere) {
+/// A receiver's position with its geodetic coordinates and ENU rotation, for the zero differences of an epoch.
+struct ReceiverGeometry {
+  Eigen::Vector3d p_E_m;
+  core::Geodetic g;
+  Eigen::Matrix3d R_NE;
+
+  explicit ReceiverGeometry(const Eigen::Vector3d& p_E)
+      : p_E_m(p_E), g(core::ecef_to_geodetic(p_E)), R_NE(core::rotation_enu_from_ecef(g)) {}
+};
+
+ZeroDiff zero_difference(gnss::EpochSatelliteStates& states, const SatelliteId sat, double pseudorange_m,
+                         const ReceiverGeometry& receiver, bool troposphere) {
   ZeroDiff z;
-  const auto state = eph.state_at_reception(sat, t_rx, pseudorange_m, nullptr, false);
+  const auto state = states.at_reception(sat, pseudorange_m, false);
   if (!state) return z;
-  const double range_m = gnss::geometric_range_m(state->p_E_m, p_E, &z.los_E);
-  const core::AzEl azel = core::azimuth_elevation(p_E, g, state->p_E_m);
-  z.elevation_rad = azel.elevation_rad;
+  const double range_m = gnss::geometric_range_m(state->p_E_m, receiver.p_E_m, &z.los_E);
+  z.elevation_rad = core::elevation_rad(receiver.p_E_m, receiver.g, receiver.R_NE, state->p_E_m);
   z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s +
-              (troposphere ? gnss::saastamoinen_delay_m(g, azel.elevation_rad) : 0.0);
+              (troposphere ? gnss::saastamoinen_delay_m(receiver.g, z.elevation_rad) : 0.0);
   z.valid = true;
   return z;
 }
@@ -87,15 +96,198 @@ struct DdRow {
     }
     entries[static_cast<std::size_t>(num_entries++)] = {index, coefficient};
   }
-  /// This row times the columns of M (M has the state dimension as rows): (H M) for one row.
-  [[nodiscard]] Eigen::RowVectorXd times(const Eigen::MatrixXd& M) const {
-    Eigen::RowVectorXd r = h_pos.transpose() * M.topRows<3>();
+  /// h . c for a state-sized column c (e.g. a column of P H^T).
+  [[nodiscard]] double dot(const Eigen::Ref<const Eigen::VectorXd>& c) const {
+    double sum = h_pos.dot(c.head<3>());
     for (int k = 0; k < num_entries; ++k) {
-      r += entries[static_cast<std::size_t>(k)].second * M.row(entries[static_cast<std::size_t>(k)].first);
+      sum += entries[static_cast<std::size_t>(k)].second * c[entries[static_cast<std::size_t>(k)].first];
     }
-    return r;
+    return sum;
+  }
+  /// P h for a symmetric P: one column of P H^T, from columns of P.
+  void covariance_times(const Eigen::MatrixXd& P, Eigen::Ref<Eigen::VectorXd> P_h) const {
+    P_h = h_pos[0] * P.col(0) + h_pos[1] * P.col(1) + h_pos[2] * P.col(2);
+    for (int k = 0; k < num_entries; ++k) {
+      P_h += entries[static_cast<std::size_t>(k)].second * P.col(entries[static_cast<std::size_t>(k)].first);
+    }
   }
 };
+
+// The Kalman update, for the sizes of RTK (tens of states and rows). Column major throughout; the kernels below are
+// plain loops and matrix-vector products because Eigen's blocked matrix-matrix routines spend more on packing than
+// on arithmetic at these sizes.
+
+/// In-place Cholesky factorisation A = L L^T of a symmetric positive definite m x m matrix given by its lower
+/// triangle; L overwrites the lower triangle, the strict upper triangle is neither read nor written. False if A is
+/// not positive definite.
+bool cholesky_lower_in_place(Eigen::MatrixXd& A) {
+  const Eigen::Index m = A.rows();
+  double* a = A.data();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    // Left looking: column j minus the contributions of the columns already factorised, four at a time (one pass
+    // over column j per four), then scaled.
+    double* a_j = a + j * m;
+    Eigen::Index k = 0;
+    for (; k + 4 <= j; k += 4) {
+      const double* a_0 = a + k * m;
+      const double* a_1 = a_0 + m;
+      const double* a_2 = a_1 + m;
+      const double* a_3 = a_2 + m;
+      const double l_0 = a_0[j], l_1 = a_1[j], l_2 = a_2[j], l_3 = a_3[j];
+      for (Eigen::Index i = j; i < m; ++i) a_j[i] -= (l_0 * a_0[i] + l_1 * a_1[i]) + (l_2 * a_2[i] + l_3 * a_3[i]);
+    }
+    for (; k < j; ++k) {
+      const double* a_k = a + k * m;
+      const double l_jk = a_k[j];
+      for (Eigen::Index i = j; i < m; ++i) a_j[i] -= l_jk * a_k[i];
+    }
+    if (!(a_j[j] > 0.0)) return false;
+    const double l_jj = std::sqrt(a_j[j]);
+    a_j[j] = l_jj;
+    for (Eigen::Index i = j + 1; i < m; ++i) a_j[i] /= l_jj;
+  }
+  return true;
+}
+
+/// B <- L^-1 B in place (L lower triangular m x m, in the lower triangle of L; B m x k).
+template <typename Derived>
+void solve_lower_in_place(const Eigen::MatrixXd& L, Eigen::MatrixBase<Derived>& B) {
+  const Eigen::Index m = L.rows();
+  for (Eigen::Index j = 0; j < B.cols(); ++j) {
+    auto b = B.col(j);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const double y_k = b[k] / L(k, k);
+      b[k] = y_k;
+      b.tail(m - k - 1) -= y_k * L.col(k).tail(m - k - 1);
+    }
+  }
+}
+
+/// X <- X L^-T in place (X n x m, L lower triangular m x m): column k of the result is
+/// (X_k - sum_{j<k} L_kj X_j) / L_kk, one matrix-vector product per column.
+void solve_transposed_lower_from_right_in_place(const Eigen::MatrixXd& L, Eigen::MatrixXd& X) {
+  for (Eigen::Index k = 0; k < X.cols(); ++k) {
+    if (k > 0) X.col(k).noalias() -= X.leftCols(k) * L.row(k).head(k).transpose();
+    X.col(k) /= L(k, k);
+  }
+}
+
+/// P <- sym(P) - U V^T for an n x n P with U V^T symmetric (U, V n x r), where sym(P) = (P + P^T) / 2 (P itself when
+/// symmetric): computed on the lower triangle, one matrix-vector product per column, and mirrored, so that P is
+/// exactly symmetric afterwards.
+void subtract_symmetric_product(Eigen::MatrixXd& P, const Eigen::MatrixXd& U, const Eigen::MatrixXd& V) {
+  const Eigen::Index n = P.rows();
+  const Eigen::Index r = U.cols();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    double* p_j = P.col(j).data();
+    for (Eigen::Index i = j + 1; i < n; ++i) p_j[i] = 0.5 * (p_j[i] + P(j, i));
+    Eigen::Index c = 0;
+    for (; c + 4 <= r; c += 4) {  // four columns of U per pass over column j of P
+      const double* u_0 = U.col(c).data();
+      const double* u_1 = U.col(c + 1).data();
+      const double* u_2 = U.col(c + 2).data();
+      const double* u_3 = U.col(c + 3).data();
+      const double v_0 = V(j, c), v_1 = V(j, c + 1), v_2 = V(j, c + 2), v_3 = V(j, c + 3);
+      for (Eigen::Index i = j; i < n; ++i) p_j[i] -= (v_0 * u_0[i] + v_1 * u_1[i]) + (v_2 * u_2[i] + v_3 * u_3[i]);
+    }
+    for (; c < r; ++c) {
+      const double v_jc = V(j, c);
+      const double* u_c = U.col(c).data();
+      for (Eigen::Index i = j; i < n; ++i) p_j[i] -= v_jc * u_c[i];
+    }
+    for (Eigen::Index i = j + 1; i < n; ++i) P(j, i) = p_j[i];
+  }
+}
+
+/// The states a block of DD rows touches, ascending, and the rows' Jacobian on them (H = H_J on J, zero elsewhere).
+struct CompressedJacobian {
+  std::vector<int> states;  // J
+  Eigen::MatrixXd H_J;      // rows x |J|
+};
+
+CompressedJacobian compress(const std::vector<const DdRow*>& rows) {
+  CompressedJacobian c;
+  c.states = {0, 1, 2};
+  for (const DdRow* row : rows) {
+    for (int k = 0; k < row->num_entries; ++k) c.states.push_back(row->entries[static_cast<std::size_t>(k)].first);
+  }
+  std::sort(c.states.begin(), c.states.end());
+  c.states.erase(std::unique(c.states.begin(), c.states.end()), c.states.end());
+  c.H_J = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(c.states.size()));
+  for (std::size_t a = 0; a < rows.size(); ++a) {
+    const auto r = static_cast<Eigen::Index>(a);
+    c.H_J.row(r).head<3>() = rows[a]->h_pos.transpose();
+    for (int k = 0; k < rows[a]->num_entries; ++k) {
+      const auto& [state, coefficient] = rows[a]->entries[static_cast<std::size_t>(k)];
+      const auto column = std::lower_bound(c.states.begin(), c.states.end(), state) - c.states.begin();
+      c.H_J(r, column) += coefficient;
+    }
+  }
+  return c;
+}
+
+/// The effect of one block of measurements on the state: x' = x + dx, P' = P - U V^T.
+struct KalmanStep {
+  Eigen::VectorXd dx;
+  Eigen::MatrixXd U;
+  Eigen::MatrixXd V;
+};
+
+/// Update with rows that touch few states (the DD code: position, and ionosphere states when estimated), in
+/// compressed form. With A = P E_J (the columns of P of the states J) and S = H_J P_JJ H_J^T + R = L L^T:
+///   G = L^-1 H_J,  W = G^T G = H_J^T S^-1 H_J,  dx = A G^T L^-1 v,  P' = P - (A W) A^T.
+/// R(a, b), a >= b, is the measurement covariance. nullopt if S is not positive definite.
+template <typename Covariance>
+std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P, const std::vector<const DdRow*>& rows,
+                                            Eigen::VectorXd v, const Covariance& R) {
+  const CompressedJacobian c = compress(rows);
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  const auto q = static_cast<Eigen::Index>(c.states.size());
+  KalmanStep step;
+  step.V.resize(P.rows(), q);  // A
+  for (Eigen::Index j = 0; j < q; ++j) step.V.col(j) = P.col(c.states[static_cast<std::size_t>(j)]);
+  Eigen::MatrixXd P_JJ(q, q);
+  for (Eigen::Index i = 0; i < q; ++i) P_JJ.row(i) = step.V.row(c.states[static_cast<std::size_t>(i)]);
+  const Eigen::MatrixXd H_P_JJ = c.H_J.lazyProduct(P_JJ);
+  Eigen::MatrixXd S(m, m);
+  for (Eigen::Index b = 0; b < m; ++b) {
+    for (Eigen::Index a = b; a < m; ++a) S(a, b) = H_P_JJ.row(a).dot(c.H_J.row(b)) + R(a, b);
+  }
+  if (!cholesky_lower_in_place(S)) return std::nullopt;
+  Eigen::MatrixXd G = c.H_J;
+  solve_lower_in_place(S, G);
+  solve_lower_in_place(S, v);
+  step.dx = step.V * (G.transpose() * v);
+  step.U = step.V.lazyProduct(G.transpose().lazyProduct(G));
+  return step;
+}
+
+/// Update with rows that touch most states (the DD phase), at the covariance P - U_prior V_prior^T of a preceding
+/// step that is not applied yet. With X = P H^T (from the sparse rows) and S = H X + R = L L^T:
+///   dx = (X L^-T) L^-1 v,  P' = P - (X L^-T) (X L^-T)^T.
+/// R(a, b), a >= b, is the measurement covariance. nullopt if S is not positive definite.
+template <typename Covariance>
+std::optional<KalmanStep> dense_update(const Eigen::MatrixXd& P, const KalmanStep& prior,
+                                       const std::vector<const DdRow*>& rows, Eigen::VectorXd v, const Covariance& R) {
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  KalmanStep step;
+  step.U.resize(P.rows(), m);
+  for (Eigen::Index a = 0; a < m; ++a) {
+    const DdRow& row = *rows[static_cast<std::size_t>(a)];
+    row.covariance_times(P, step.U.col(a));
+    for (Eigen::Index j = 0; j < prior.V.cols(); ++j) step.U.col(a) -= row.dot(prior.V.col(j)) * prior.U.col(j);
+  }
+  Eigen::MatrixXd S(m, m);
+  for (Eigen::Index b = 0; b < m; ++b) {
+    for (Eigen::Index a = b; a < m; ++a) S(a, b) = rows[static_cast<std::size_t>(a)]->dot(step.U.col(b)) + R(a, b);
+  }
+  if (!cholesky_lower_in_place(S)) return std::nullopt;
+  solve_transposed_lower_from_right_in_place(S, step.U);
+  solve_lower_in_place(S, v);
+  step.dx = step.U * v;
+  step.V = step.U;
+  return step;
+}
 
 }  // namespace
 
@@ -114,7 +306,8 @@ struct SingleDiff {
   std::uint8_t lli = 0;     // rover | base loss-of-lock bits
   int ambiguity = -1;       // state index of N_sd, -1 if none
   int iono = -1;            // state index of the satellite's SD ionosphere, -1 if not estimated
-  double iono_scale = 1.0;  // (f_1 / f)^2: the delay on this frequency per metre of first-frequency delay
+  double iono_scale = 1.0;  // (f_1 / f)^2: the delay on this frequency per metre of first-frequency delay (when
+                            // the ionosphere is estimated)
   bool fixable = false;
 };
 
@@ -167,27 +360,44 @@ int RtkEngine::ambiguity_index(const AmbiguityKey& key) const {
   return it == ambiguity_keys_.end() ? -1 : num_kinematic_states() + static_cast<int>(it - ambiguity_keys_.begin());
 }
 
+void RtkEngine::add_states(const std::vector<NewState>& states) {
+  if (states.empty()) return;
+  const Eigen::Index n = x_.size();
+  const auto added = static_cast<Eigen::Index>(states.size());
+  // One new x and P (a copy of the old block, zeros, the new variances) rather than one resize per state.
+  Eigen::VectorXd x(n + added);
+  x.head(n) = x_;
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(n + added, n + added);
+  P.topLeftCorner(n, n) = P_;
+  for (Eigen::Index i = 0; i < added; ++i) {
+    const NewState& state = states[static_cast<std::size_t>(i)];
+    x[n + i] = state.value;
+    P(n + i, n + i) = state.variance;
+    ambiguity_keys_.push_back(state.key);
+  }
+  x_.swap(x);
+  P_.swap(P);
+}
+
 void RtkEngine::add_ambiguity(const AmbiguityKey& key, double value, double variance) {
-  const auto n = x_.size();
-  x_.conservativeResize(n + 1);
-  x_[n] = value;
-  P_.conservativeResize(n + 1, n + 1);
-  P_.row(n).setZero();
-  P_.col(n).setZero();
-  P_(n, n) = variance;
-  ambiguity_keys_.push_back(key);
+  add_states({NewState{key, value, variance}});
 }
 
 void RtkEngine::remove_ambiguity(const AmbiguityKey& key) {
   const int index = ambiguity_index(key);
   if (index < 0) return;
+  // x and P without the state: one copy into new storage (four blocks of P), no shifting in place.
   const auto n = x_.size();
   const auto tail = n - index - 1;
-  x_.segment(index, tail) = x_.tail(tail).eval();
-  x_.conservativeResize(n - 1);
-  P_.block(index, 0, tail, n) = P_.bottomRows(tail).eval();
-  P_.block(0, index, n, tail) = P_.rightCols(tail).eval();
-  P_.conservativeResize(n - 1, n - 1);
+  Eigen::VectorXd x(n - 1);
+  x << x_.head(index), x_.tail(tail);
+  Eigen::MatrixXd P(n - 1, n - 1);
+  P.topLeftCorner(index, index) = P_.topLeftCorner(index, index);
+  P.topRightCorner(index, tail) = P_.topRightCorner(index, tail);
+  P.bottomLeftCorner(tail, index) = P_.bottomLeftCorner(tail, index);
+  P.bottomRightCorner(tail, tail) = P_.bottomRightCorner(tail, tail);
+  x_.swap(x);
+  P_.swap(P);
   ambiguity_keys_.erase(ambiguity_keys_.begin() + (index - num_kinematic_states()));
   ambiguity_info_.erase(key);
   for (auto it = last_fix_.begin(); it != last_fix_.end();) {
@@ -255,13 +465,19 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     if (t - info.last_seen > options_.max_outage_s) stale.push_back(key);
   }
   for (const auto& key : stale) remove_ambiguity(key);
+  // New states are collected and appended at once (in the order found, as one by one).
+  std::vector<NewState> new_states;
+  const auto has_state = [&](const AmbiguityKey& key) {
+    return ambiguity_index(key) >= 0 ||
+           std::any_of(new_states.begin(), new_states.end(), [&](const NewState& s) { return s.key == key; });
+  };
   for (SingleDiff& sd : sds) {
     if (!core::has_value(sd.phase_m)) continue;
     const AmbiguityKey key{sd.sat, sd.frequency};
-    if (ambiguity_index(key) < 0) {
+    if (!has_state(key)) {
       if (!core::has_value(sd.code_m)) continue;
       const double sigma = options_.initial_ambiguity_sigma_cyc;
-      add_ambiguity(key, (sd.phase_m - sd.code_m) / sd.wavelength_m, sigma * sigma);
+      new_states.push_back(NewState{key, (sd.phase_m - sd.code_m) / sd.wavelength_m, sigma * sigma});
       ambiguity_info_[key] = AmbiguityInfo{};
     }
     AmbiguityInfo& a = ambiguity_info_[key];
@@ -279,10 +495,11 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     const double sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m);
     for (const SingleDiff& sd : sds) {
       const AmbiguityKey key{sd.sat, kIonoKey};
-      if (ambiguity_index(key) < 0) add_ambiguity(key, 0.0, sigma_m * sigma_m);
+      if (!has_state(key)) new_states.push_back(NewState{key, 0.0, sigma_m * sigma_m});
       ambiguity_info_[key].last_seen = t;
     }
   }
+  add_states(new_states);
   for (SingleDiff& sd : sds) {
     sd.ambiguity = core::has_value(sd.phase_m) ? ambiguity_index({sd.sat, sd.frequency}) : -1;
     sd.iono = ambiguity_index({sd.sat, kIonoKey});
@@ -369,55 +586,63 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
     }
   }
   if (rows.empty()) return 0;
-  const auto m = static_cast<Eigen::Index>(rows.size());
-  Eigen::VectorXd v(m);
-  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(m, m);
-  // P H^T column by column from the sparse rows (P is symmetric: column a of P H^T is row a of H P, transposed).
-  Eigen::MatrixXd PHt(n, m);
-  for (Eigen::Index a = 0; a < m; ++a) {
-    const DdRow& ra = rows[static_cast<std::size_t>(a)];
-    PHt.col(a) = ra.times(P_).transpose();
-    v[a] = ra.innovation_m;
-    const auto variance = [&](int i) {
-      const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
-      return ra.phase ? sd.phase_variance_m2 : sd.code_variance_m2;
+  // DD measurement covariance: the SD variances of s and of its reference on the diagonal; rows of one kind that
+  // share a reference are correlated through it. Code and phase rows are uncorrelated.
+  const auto sd_variance = [&](const DdRow& row, int i) {
+    const SingleDiff& sd = sds[static_cast<std::size_t>(i)];
+    return row.phase ? sd.phase_variance_m2 : sd.code_variance_m2;
+  };
+  const auto covariance = [&](const DdRow& ra, const DdRow& rb) {
+    if (&ra == &rb) return sd_variance(ra, ra.sd) + sd_variance(ra, ra.reference);
+    return rb.phase == ra.phase && rb.reference == ra.reference ? sd_variance(ra, ra.reference) : 0.0;
+  };
+  // R being block diagonal, the update is two sequential ones, the same as the joint update in exact arithmetic:
+  // the code rows, which touch only the position (and ionosphere states), in compressed form, then the phase rows at
+  // the code-updated covariance. Neither is applied before both factorisations have succeeded.
+  std::vector<const DdRow*> code_rows;
+  std::vector<const DdRow*> phase_rows;
+  for (const DdRow& row : rows) (row.phase ? phase_rows : code_rows).push_back(&row);
+  const auto block_covariance = [&](const std::vector<const DdRow*>& block) {
+    return [&covariance, &block](Eigen::Index a, Eigen::Index b) {
+      return covariance(*block[static_cast<std::size_t>(a)], *block[static_cast<std::size_t>(b)]);
     };
-    R(a, a) = variance(ra.sd) + variance(ra.reference);
-    for (Eigen::Index b = 0; b < a; ++b) {
-      const DdRow& rb = rows[static_cast<std::size_t>(b)];
-      if (rb.phase == ra.phase && rb.reference == ra.reference) R(a, b) = R(b, a) = variance(ra.reference);
-    }
+  };
+  const auto innovations = [](const std::vector<const DdRow*>& block, const Eigen::VectorXd& dx) {
+    Eigen::VectorXd v(static_cast<Eigen::Index>(block.size()));
+    for (std::size_t a = 0; a < block.size(); ++a)
+      v[static_cast<Eigen::Index>(a)] = block[a]->innovation_m - block[a]->dot(dx);
+    return v;
+  };
+  KalmanStep code_step{Eigen::VectorXd::Zero(n), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(n, 0)};
+  if (!code_rows.empty()) {
+    auto step = compressed_update(P_, code_rows, innovations(code_rows, code_step.dx), block_covariance(code_rows));
+    if (!step) return 0;
+    code_step = std::move(*step);
   }
-  // S = H P H^T + R, row by row from the sparse rows: S_a = H_a (P H^T).
-  Eigen::MatrixXd S = R;
-  for (Eigen::Index a = 0; a < m; ++a) S.row(a) += rows[static_cast<std::size_t>(a)].times(PHt);
-  S = 0.5 * (S + S.transpose()).eval();
-  // Kalman update: K = P H^T S^-1.
-  const Eigen::LLT<Eigen::MatrixXd> llt(S);
-  if (llt.info() != Eigen::Success) return 0;
-  const Eigen::MatrixXd L_inv_HP = llt.matrixL().solve(PHt.transpose());  // L^-1 H P, m x n
-  const Eigen::VectorXd dx = PHt * llt.solve(v);
+  KalmanStep phase_step{Eigen::VectorXd::Zero(n), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(n, 0)};
+  if (!phase_rows.empty()) {
+    auto step =
+        dense_update(P_, code_step, phase_rows, innovations(phase_rows, code_step.dx), block_covariance(phase_rows));
+    if (!step) return 0;
+    phase_step = std::move(*step);
+  }
+  const Eigen::VectorXd dx = code_step.dx + phase_step.dx;
   x_ += dx;
-  P_.noalias() -= L_inv_HP.transpose() * L_inv_HP;
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  Eigen::MatrixXd U(n, code_step.U.cols() + phase_step.U.cols());
+  Eigen::MatrixXd V(n, U.cols());
+  U << code_step.U, phase_step.U;
+  V << code_step.V, phase_step.V;
+  subtract_symmetric_product(P_, U, V);
   // Post-fit DD phase residuals, normalised by their measurement sigma: the worst one is reported.
   post_fit = PostFit{};
-  for (Eigen::Index a = 0; a < m; ++a) {
-    const DdRow& row = rows[static_cast<std::size_t>(a)];
-    if (!row.phase) continue;
-    double h_dx = row.h_pos.dot(dx.head<3>());
-    for (int k = 0; k < row.num_entries; ++k) {
-      h_dx += row.entries[static_cast<std::size_t>(k)].second * dx[row.entries[static_cast<std::size_t>(k)].first];
-    }
-    const double normalised = std::abs(v[a] - h_dx) / std::sqrt(R(a, a));
+  for (const DdRow* row : phase_rows) {
+    const double normalised = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
     if (normalised > post_fit.worst_normalised) {
       post_fit.worst_normalised = normalised;
-      post_fit.worst_sd = row.sd;
+      post_fit.worst_sd = row->sd;
     }
   }
-  int phase_rows = 0;
-  for (const DdRow& r : rows) phase_rows += r.phase ? 1 : 0;
-  return phase_rows;
+  return static_cast<int>(phase_rows.size());
 }
 
 namespace {
@@ -663,7 +888,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
 }
 
 Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
-  auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_);
+  // The rover's satellite states are computed once, for the single-point solution, and reused by the zero
+  // differences.
+  gnss::EpochSatelliteStates rover_states(eph_, rover.time);
+  auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_, &rover_states);
   if (!spp) return spp.error();
   last_spp_p_E_m_ = spp->p_E_m;
 
@@ -694,7 +922,7 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
   const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
   detect_slips(rover_obs, base_obs);
-  std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs);
+  std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs, rover_states);
   update_ambiguities(sds, rover.time);
   out.num_dd_measurements = measurement_update(sds, out.rejected);
   if (out.num_dd_measurements == 0) {
@@ -714,11 +942,12 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
 }
 
 std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables& rover_obs,
-                                                      const ReceiverObservables& base_obs) const {
-  const Eigen::Vector3d p_E_u = x_.head<3>();
-  const core::Geodetic g_u = core::ecef_to_geodetic(p_E_u);
-  const core::Geodetic g_b = core::ecef_to_geodetic(p_E_base_m_);
+                                                      const ReceiverObservables& base_obs,
+                                                      gnss::EpochSatelliteStates& rover_states) const {
+  const ReceiverGeometry rover(x_.head<3>());
+  const ReceiverGeometry base(p_E_base_m_);
   const bool tropo = options_.troposphere_saastamoinen;
+  gnss::EpochSatelliteStates base_states(eph_, base_obs.time);
   std::vector<SingleDiff> sds;
   sds.reserve(rover_obs.signals.size());
   SatelliteId current{};
@@ -732,9 +961,8 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
       current = r.sat;
       const double pr_r = any_pseudorange(rover_obs, r.sat);
       const double pr_b = any_pseudorange(base_obs, r.sat);
-      zr = core::has_value(pr_r) ? zero_difference(eph_, r.sat, rover_obs.time, pr_r, p_E_u, g_u, tropo) : ZeroDiff{};
-      zb = core::has_value(pr_b) ? zero_difference(eph_, r.sat, base_obs.time, pr_b, p_E_base_m_, g_b, tropo)
-                                 : ZeroDiff{};
+      zr = core::has_value(pr_r) ? zero_difference(rover_states, r.sat, pr_r, rover, tropo) : ZeroDiff{};
+      zb = core::has_value(pr_b) ? zero_difference(base_states, r.sat, pr_b, base, tropo) : ZeroDiff{};
     }
     if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
     SingleDiff sd;
@@ -742,7 +970,9 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
     sd.frequency = r.frequency;
     sd.group = static_cast<int>(r.sat.system) * kMaxFrequencies + r.frequency;
     sd.wavelength_m = r.wavelength_m;
-    sd.iono_scale = std::pow(r.wavelength_m / first_wavelength_m(eph_, r.sat), 2);
+    if (options_.ionosphere == IonosphereModel::Estimate) {
+      sd.iono_scale = std::pow(r.wavelength_m / first_wavelength_m(eph_, r.sat), 2);
+    }
     sd.lli = static_cast<std::uint8_t>(r.lli | b->lli);
     const double model_m = zr.model_m - zb.model_m;
     if (core::has_value(r.carrier_phase_cyc) && core::has_value(b->carrier_phase_cyc) &&

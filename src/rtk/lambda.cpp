@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <ranges>
@@ -49,17 +50,36 @@ Status check_problem(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a,
 }
 
 Status check_symmetric(const Eigen::MatrixXd& Q, const char* who) {
-  const double scale = Q.cwiseAbs().maxCoeff();
-  if ((Q - Q.transpose()).cwiseAbs().maxCoeff() > kSymmetryTolerance * scale) {
+  double scale = 0.0;      // max |Q_ij|
+  double asymmetry = 0.0;  // max |Q_ij - Q_ji|
+  for (Eigen::Index j = 0; j < Q.cols(); ++j) {
+    for (Eigen::Index i = 0; i < Q.rows(); ++i) {
+      scale = std::max(scale, std::abs(Q(i, j)));
+      if (i > j) asymmetry = std::max(asymmetry, std::abs(Q(i, j) - Q(j, i)));
+    }
+  }
+  if (asymmetry > kSymmetryTolerance * scale) {
     return Error(std::string(who) + ": Q_a is not symmetric");
   }
   return Ok{};
 }
 
+/// std::round (to nearest, halves away from zero), bit for bit, without the library call that std::round is on
+/// x86-64 without SSE4.1 (it dominated the search and the reduction). Below 2^52 the integer part of |x| fits an
+/// int64 and |x| minus it is exact; from 2^52 on every double is an integer.
+double round_half_away(double x) {
+  constexpr double kAllIntegers = 4503599627370496.0;  // 2^52
+  const double a = std::abs(x);
+  if (!(a < kAllIntegers)) return x;                       // integers, infinities and NaN round to themselves
+  const auto whole = static_cast<std::int64_t>(a);         // floor(|x|)
+  const double fraction = a - static_cast<double>(whole);  // exact
+  return std::copysign(static_cast<double>(whole + (fraction >= 0.5 ? 1 : 0)), x);
+}
+
 /// Round to nearest for a multiplier of an integer Gauss transformation; 0 when |x| <= 1/2 (already size-reduced),
-/// which is the common case and avoids the libm call.
+/// the common case.
 double gauss_multiplier(double x) {
-  return std::abs(x) <= 0.5 ? 0.0 : std::round(x);
+  return std::abs(x) <= 0.5 ? 0.0 : round_half_away(x);
 }
 
 /// One factor of Z = P O_1 O_2 ...: an integer Gauss transformation I - mu e_i e_k^T, or (mu == 0) the swap of
@@ -70,19 +90,27 @@ struct ElementaryOperation {
   double mu;
 };
 
-/// a = Z^{-T} z = P O_1^{-T} O_2^{-T} ... z, exact in integer arithmetic; O(number of operations), not O(n^2) per
-/// operation as accumulating Z^{-1} would be. (I - mu e_i e_k^T)^{-T} = I + mu e_k e_i^T.
-void back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm, double* z,
-                    double* a) {
+/// a_j = Z^{-T} z_j = P O_1^{-T} O_2^{-T} ... z_j for every column j of z (n x m), exact in integer arithmetic;
+/// O(number of operations), not O(n^2) per operation as accumulating Z^{-1} would be, and one pass over the log for
+/// all candidates. (I - mu e_i e_k^T)^{-T} = I + mu e_k e_i^T.
+Eigen::MatrixXd back_transform(const std::vector<ElementaryOperation>& log, const std::vector<Eigen::Index>& perm,
+                               const Eigen::MatrixXd& z) {
+  const Eigen::Index m = z.cols();
+  Eigen::MatrixXd z_T = z.transpose();  // column i holds entry i of every candidate, contiguous
+  double* const entries = z_T.data();
   for (std::size_t k = log.size(); k-- > 0;) {  // newest first (no ranges: clang-tidy 14 cannot parse them)
     const ElementaryOperation& op = log[k];
+    double* z_k = entries + op.k * m;
+    double* z_i = entries + op.i * m;
     if (op.mu == 0.0) {
-      std::swap(z[op.k], z[op.i]);
+      for (Eigen::Index j = 0; j < m; ++j) std::swap(z_k[j], z_i[j]);
     } else {
-      z[op.k] += op.mu * z[op.i];
+      for (Eigen::Index j = 0; j < m; ++j) z_k[j] += op.mu * z_i[j];
     }
   }
-  for (std::size_t i = 0; i < perm.size(); ++i) a[perm[i]] = z[i];
+  Eigen::MatrixXd a(z.rows(), m);
+  for (std::size_t i = 0; i < perm.size(); ++i) a.row(perm[i]) = z_T.col(static_cast<Eigen::Index>(i)).transpose();
+  return a;
 }
 
 /// Working view of a decorrelation during factorisation and reduction: raw column-major n x n arrays, so that every
@@ -92,21 +120,20 @@ struct ReductionView {
   Eigen::Index n;
   double* L;        // L(i, k) = L[i + k n], unit lower triangular
   double* d;        // d[k]
-  double* Z;        // Z(i, k) = Z[i + k n]
+  double* Z;        // Z(i, k) = Z[i + k n], or nullptr when Z is not wanted
   double* Z_inv_T;  // Z^{-T}(i, k) = Z_inv_T[i + k n], or nullptr when the operations are logged instead
   double* z_hat;    // Z^T (a_float - shift), or nullptr
   std::vector<Eigen::Index>* perm = nullptr;        // initial permutation: Z(perm[i], i) = 1 before the reduction
   std::vector<ElementaryOperation>* log = nullptr;  // Z = P O_1 O_2 ..., in order, when Z_inv_T is nullptr
 };
 
-/// Q = P L^T D L P^T with symmetric pivoting (see the contract): fills L, d, and Z = P, Z_inv_T = P.
+/// Q = P L^T D L P^T with symmetric pivoting (see the contract): fills L, d, perm, and Z = P, Z_inv_T = P when kept.
 Status factorise_with_pivoting(const Eigen::MatrixXd& Q, Eigen::MatrixXd& W, const ReductionView& v) {
   const Eigen::Index n = v.n;
   W = 0.5 * (Q + Q.transpose());
   double* w = W.data();
   const double min_pivot = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * W.diagonal().maxCoeff();
   std::fill(v.L, v.L + n * n, 0.0);
-  std::fill(v.Z, v.Z + n * n, 0.0);
   // perm[i] = original index of the variable now at position i.
   std::vector<Eigen::Index> perm(static_cast<std::size_t>(n));
   std::iota(perm.begin(), perm.end(), Eigen::Index{0});
@@ -138,23 +165,26 @@ Status factorise_with_pivoting(const Eigen::MatrixXd& Q, Eigen::MatrixXd& W, con
       for (Eigen::Index i = 0; i < k; ++i) w_col[i] -= w_col_k[i] * l_j;
     }
   }
-  for (Eigen::Index i = 0; i < n; ++i) v.Z[perm[static_cast<std::size_t>(i)] + i * n] = 1.0;
-  if (v.Z_inv_T != nullptr) std::copy(v.Z, v.Z + n * n, v.Z_inv_T);  // a permutation: Z^{-T} = Z
+  if (v.Z != nullptr) {
+    std::fill(v.Z, v.Z + n * n, 0.0);
+    for (Eigen::Index i = 0; i < n; ++i) v.Z[perm[static_cast<std::size_t>(i)] + i * n] = 1.0;
+    if (v.Z_inv_T != nullptr) std::copy(v.Z, v.Z + n * n, v.Z_inv_T);  // a permutation: Z^{-T} = Z
+  }
   if (v.perm != nullptr) *v.perm = std::move(perm);
   return Ok{};
 }
 
-/// Integer Gauss transformation G_ik (i > k) applied to L, Z, Z_inv_T and z_hat; false when L_ik is already reduced.
-bool gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
+/// Integer Gauss transformation G_ik (i > k) with multiplier mu != 0 applied to L, Z, Z_inv_T and z_hat.
+void apply_gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k, double mu) {
   const Eigen::Index n = v.n;
-  const double mu = gauss_multiplier(v.L[i + k * n]);
-  if (mu == 0.0) return false;
   double* L_k = v.L + k * n;
   const double* L_i = v.L + i * n;
   for (Eigen::Index r = i; r < n; ++r) L_k[r] -= mu * L_i[r];
-  double* Z_k = v.Z + k * n;
-  const double* Z_i = v.Z + i * n;
-  for (Eigen::Index r = 0; r < n; ++r) Z_k[r] -= mu * Z_i[r];
+  if (v.Z != nullptr) {
+    double* Z_k = v.Z + k * n;
+    const double* Z_i = v.Z + i * n;
+    for (Eigen::Index r = 0; r < n; ++r) Z_k[r] -= mu * Z_i[r];
+  }
   if (v.Z_inv_T != nullptr) {
     double* Zit_i = v.Z_inv_T + i * n;  // Z^{-1} <- G^{-1} Z^{-1}: row i += mu row k, i.e. column i of Z^{-T}
     const double* Zit_k = v.Z_inv_T + k * n;
@@ -163,7 +193,13 @@ bool gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
     v.log->push_back({i, k, mu});
   }
   if (v.z_hat != nullptr) v.z_hat[k] -= mu * v.z_hat[i];
-  return true;
+}
+
+/// G_ik with mu = round(L_ik), or nothing when L_ik is already reduced: the common case, one load and compare
+/// (inline; the reduction makes millions of these tests on a file).
+inline void gauss_transform(const ReductionView& v, Eigen::Index i, Eigen::Index k) {
+  const double mu = gauss_multiplier(v.L[i + k * v.n]);
+  if (mu != 0.0) apply_gauss_transform(v, i, k, mu);
 }
 
 /// Swap of neighbours k, k+1 given Delta = d_k + L_{k+1,k}^2 d_{k+1} (formulas at the top of this file).
@@ -175,17 +211,17 @@ void swap_neighbours(const ReductionView& v, Eigen::Index k, double delta) {
   const double eta = d_k / delta;
   const double lambda = d_k1 * mu / delta;
   for (Eigen::Index j = 0; j < k; ++j) {
-    double& row_k = v.L[k + j * n];
-    double& row_k1 = v.L[(k + 1) + j * n];
-    const double old_k = row_k;
-    row_k = row_k1 - mu * old_k;
-    row_k1 = eta * old_k + lambda * row_k1;
+    double* rows_k = v.L + k + j * n;  // L(k, j), L(k + 1, j)
+    const double l_k = rows_k[0];
+    const double l_k1 = rows_k[1];
+    rows_k[0] = l_k1 - mu * l_k;
+    rows_k[1] = eta * l_k + lambda * l_k1;
   }
   v.L[(k + 1) + k * n] = lambda;
   std::swap_ranges(v.L + k * n + k + 2, v.L + k * n + n, v.L + (k + 1) * n + k + 2);
   v.d[k] = eta * d_k1;
   v.d[k + 1] = delta;
-  std::swap_ranges(v.Z + k * n, v.Z + (k + 1) * n, v.Z + (k + 1) * n);
+  if (v.Z != nullptr) std::swap_ranges(v.Z + k * n, v.Z + (k + 1) * n, v.Z + (k + 1) * n);
   if (v.Z_inv_T != nullptr) {
     std::swap_ranges(v.Z_inv_T + k * n, v.Z_inv_T + (k + 1) * n, v.Z_inv_T + (k + 1) * n);
   } else {
@@ -212,7 +248,10 @@ Status reduce(const ReductionView& v) {
       // cannot grow over repeated swaps (the instability of reducing the sub-diagonal only). Leaves L_{k+1,k}, d.
       for (Eigen::Index i = k + 2; i < n; ++i) gauss_transform(v, i, k);
       swap_neighbours(v, k, delta);
-      k = n - 2;
+      // MLAMBDA restarts from k = n - 2; levels above k + 1 are untouched by this swap (their L_{j+1,j} and d
+      // are those already reduced and tested), so those tests would fail again with no Gauss transformation:
+      // resuming at k + 1 gives the same sequence of operations in O(1) instead of O(n) steps per swap.
+      k = std::min(k + 1, n - 2);
     } else {
       --k;
     }
@@ -226,21 +265,26 @@ Status reduce(const ReductionView& v) {
 }
 
 /// Factorisation and reduction into dec. With log == nullptr, dec.Z_inv receives Z^{-T}; otherwise dec.Z_inv is
-/// left empty and the operations are logged (with the initial permutation) for back_transform().
-Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, Eigen::VectorXd* z_hat,
+/// left empty and the operations are logged (with the initial permutation) for back_transform(). dec.Z is left empty
+/// unless with_z. z_hat (with a_centred and perm) receives Z^T a_centred.
+Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool with_z, Eigen::VectorXd* z_hat,
                         const Eigen::VectorXd* a_centred, std::vector<Eigen::Index>* perm,
                         std::vector<ElementaryOperation>* log) {
+  assert(z_hat == nullptr || (a_centred != nullptr && perm != nullptr));
   const Eigen::Index n = Q_a.rows();
   dec.L.resize(n, n);
   dec.d.resize(n);
-  dec.Z.resize(n, n);
+  if (with_z) dec.Z.resize(n, n);
   if (log == nullptr) dec.Z_inv.resize(n, n);
-  ReductionView v{n,       dec.L.data(), dec.d.data(), dec.Z.data(), log == nullptr ? dec.Z_inv.data() : nullptr,
-                  nullptr, perm,         log};
+  ReductionView v{
+      n,       dec.L.data(), dec.d.data(), with_z ? dec.Z.data() : nullptr, log == nullptr ? dec.Z_inv.data() : nullptr,
+      nullptr, perm,         log};
   Eigen::MatrixXd W;
   if (auto s = factorise_with_pivoting(Q_a, W, v); !s) return s;
   if (z_hat != nullptr) {
-    *z_hat = dec.Z.transpose() * *a_centred;
+    // Z is the pivoting permutation P at this point: Z^T a = (a_perm[0], a_perm[1], ...).
+    z_hat->resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) (*z_hat)[i] = (*a_centred)[(*perm)[static_cast<std::size_t>(i)]];
     v.z_hat = z_hat->data();
   }
   return reduce(v);
@@ -284,7 +328,7 @@ Result<BestLeaves> search(const Decorrelation& dec, const Eigen::VectorXd& z_hat
   Eigen::Index k = n - 1;
   partial[k] = 0.0;
   z_bar[k] = zh[k];
-  z[k] = std::round(z_bar[k]);
+  z[k] = round_half_away(z_bar[k]);
   double y = z_bar[k] - z[k];
   step[k] = sign_toward(y);
   nodes_used = 0;
@@ -304,7 +348,7 @@ Result<BestLeaves> search(const Decorrelation& dec, const Eigen::VectorXd& z_hat
         const double* L_row = Lt + (k + 1) * n;  // L(k + 1, 0:k)
         for (Eigen::Index i = 0; i <= k; ++i) S_k[i] = S_k1[i] + c * L_row[i];
         z_bar[k] = zh[k] + S_k[k];
-        z[k] = std::round(z_bar[k]);
+        z[k] = round_half_away(z_bar[k]);
         y = z_bar[k] - z[k];
         step[k] = sign_toward(y);
         continue;
@@ -376,7 +420,7 @@ Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a) {
   if (!Q_a.allFinite()) return Error("decorrelate: Q_a has a non-finite entry");
   if (auto s = check_symmetric(Q_a, "decorrelate"); !s) return s.error();
   Decorrelation dec;
-  if (auto s = decorrelate_into(Q_a, dec, nullptr, nullptr, nullptr, nullptr); !s) return s.error();
+  if (auto s = decorrelate_into(Q_a, dec, true, nullptr, nullptr, nullptr, nullptr); !s) return s.error();
   dec.Z_inv.transposeInPlace();
   return dec;
 }
@@ -387,14 +431,15 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
   if (auto s = check_problem(a_float, Q_a, "mlambda"); !s) return s.error();
   if (auto s = check_symmetric(Q_a, "mlambda"); !s) return s.error();
 
-  Decorrelation dec;  // dec.Z_inv stays empty: the candidates are back-transformed through the operation log
-  const Eigen::VectorXd shift = a_float.array().round().matrix();
+  // dec.Z_inv stays empty (the candidates are back-transformed through the operation log), dec.Z unless with_z.
+  Decorrelation dec;
+  const Eigen::VectorXd shift = a_float.unaryExpr(&round_half_away);
   const Eigen::VectorXd a_centred = a_float - shift;
   Eigen::VectorXd z_hat;
   std::vector<Eigen::Index> perm;
   std::vector<ElementaryOperation> log;
   log.reserve(1024);
-  if (auto s = decorrelate_into(Q_a, dec, &z_hat, &a_centred, &perm, &log); !s) return s.error();
+  if (auto s = decorrelate_into(Q_a, dec, options.with_z, &z_hat, &a_centred, &perm, &log); !s) return s.error();
 
   IntegerSearchResult out;
   auto found = search(dec, z_hat, options.num_candidates, options.max_search_nodes, out.search_nodes);
@@ -404,15 +449,15 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
             [&](int l, int r) { return found->squared_norms(l) < found->squared_norms(r); });
-  const Eigen::Index n = a_float.size();
-  out.candidates.resize(n, m);
+  Eigen::MatrixXd z_sorted(a_float.size(), m);
   out.squared_norms.resize(m);
   for (int j = 0; j < m; ++j) {
     const int from = order[static_cast<std::size_t>(j)];
-    back_transform(log, perm, found->z.col(from).data(), out.candidates.col(j).data());  // exact: integers
-    out.candidates.col(j) += shift;
+    z_sorted.col(j) = found->z.col(from);
     out.squared_norms(j) = found->squared_norms(from);
   }
+  out.candidates = back_transform(log, perm, z_sorted);  // exact: integers
+  out.candidates.colwise() += shift;
   out.Z = std::move(dec.Z);
   out.conditional_variances = std::move(dec.d);
   return out;

@@ -97,5 +97,22 @@ TEST(GeodesyTest, AzimuthElevationTable) {
       kPi / 2.0, kMaxAngleErrorRad);
 }
 
+TEST(GeodesyTest, ElevationAloneIsTheElevationOfAzimuthElevation) {
+  // Bit for bit: the engine and the SPP use the elevation-only forms where the azimuth is not needed.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int i = 0; i < 1000; ++i) {
+    const Geodetic rcv{1.5 * unit(rng), 3.1 * unit(rng), 500.0 * unit(rng)};
+    const Eigen::Vector3d p = geodetic_to_ecef(rcv);
+    const Eigen::Vector3d sat = 2.6e7 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    const Eigen::Matrix3d R_NE = rotation_enu_from_ecef(rcv);
+    EXPECT_EQ(elevation_rad(p, rcv, R_NE, sat), azimuth_elevation(p, rcv, sat).elevation_rad);
+    EXPECT_EQ(elevation_from_enu(R_NE * (sat - p)), azimuth_elevation_from_enu(R_NE * (sat - p)).elevation_rad);
+  }
+  const Geodetic centre = ecef_to_geodetic(Eigen::Vector3d::Zero());
+  EXPECT_EQ(elevation_rad(Eigen::Vector3d::Zero(), centre, rotation_enu_from_ecef(centre), Eigen::Vector3d(2e7, 0, 0)),
+            kPi / 2.0);
+}
+
 }  // namespace
 }  // namespace canyon::core

@@ -1,5 +1,6 @@
 // Ephemeris store unit tests: velocity and clock drift against numeric derivatives, GLONASS integration forward and
-// back, BeiDou GEO and GPS orbit sanity, selection rules, transmission-time iteration, group delays, Sagnac range.
+// back, BeiDou GEO and GPS orbit sanity, selection rules, transmission-time iteration, group delays, Sagnac range,
+// and the per-epoch state table.
 
 #include "canyon/gnss/ephemeris.hpp"
 
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "canyon/core/constants.hpp"
+#include "canyon/gnss/satellite_states.hpp"
 
 namespace canyon::gnss {
 namespace {
@@ -235,6 +237,32 @@ TEST(Ephemeris, StateAtReceptionSolvesLightTime) {
   const auto s_exact = store.state({Constellation::Gps, 5}, exact);
   EXPECT_LT((s->p_E_m - s_exact->p_E_m).norm(), 2e-4);
   EXPECT_NEAR(s->clock_bias_s, s_exact->clock_bias_s, 1e-15);
+}
+
+TEST(EpochSatelliteStates, AnswersAsTheStoreAndKeepsVelocityWhenAskedFor) {
+  const EphemerisStore store = store_of({gps_g05()}, {glonass_r01()});
+  const GpsTime t_rx{2320, 123000.0};
+  const core::SatelliteId g05{Constellation::Gps, 5};
+  const core::SatelliteId r01{Constellation::Glonass, 1};
+  EpochSatelliteStates states(store, t_rx);
+  const auto expect_same = [](const std::optional<SatelliteState>& a, const std::optional<SatelliteState>& b) {
+    ASSERT_EQ(a.has_value(), b.has_value());
+    if (!a) return;
+    EXPECT_EQ(a->p_E_m, b->p_E_m);
+    EXPECT_EQ(a->v_E_mps, b->v_E_mps);
+    EXPECT_EQ(a->clock_bias_s, b->clock_bias_s);
+    EXPECT_EQ(a->clock_drift_sps, b->clock_drift_sps);
+  };
+  // First request without velocity, then with: the second is computed anew (velocity is not zero), then kept.
+  expect_same(states.at_reception(g05, 22.0e6, false), store.state_at_reception(g05, t_rx, 22.0e6, nullptr, false));
+  expect_same(states.at_reception(g05, 22.0e6, true), store.state_at_reception(g05, t_rx, 22.0e6, nullptr, true));
+  expect_same(states.at_reception(g05, 22.0e6, false), store.state_at_reception(g05, t_rx, 22.0e6, nullptr, true));
+  // Another pseudorange is another transmission time.
+  expect_same(states.at_reception(g05, 23.0e6, false), store.state_at_reception(g05, t_rx, 23.0e6, nullptr, false));
+  expect_same(states.at_reception(r01, 21.0e6, true), store.state_at_reception(r01, t_rx, 21.0e6, nullptr, true));
+  // No ephemeris: nullopt, also when asked again.
+  EXPECT_FALSE(states.at_reception({Constellation::Gps, 6}, 22.0e6, false));
+  EXPECT_FALSE(states.at_reception({Constellation::Gps, 6}, 22.0e6, false));
 }
 
 TEST(Ephemeris, GroupDelays) {

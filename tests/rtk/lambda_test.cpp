@@ -341,6 +341,27 @@ TEST(MlambdaTest, MatchesEnumerationOnEkfAmbiguityProblems) {
   }
 }
 
+TEST(MlambdaTest, WithZReturnsTheDecorrelationAndTheSameCandidates) {
+  // Z is only accumulated on request; the candidates and norms do not depend on it (bit for bit), and the Z returned
+  // is decorrelate()'s.
+  std::mt19937_64 rng(67);
+  for (int satellites : {4, 9, 16}) {
+    testing::EkfAmbiguityOptions options;
+    options.num_satellites = satellites;
+    const auto p = testing::ekf_ambiguity_problem(options, rng);
+    MlambdaOptions with_z;
+    with_z.with_z = true;
+    const auto plain = mlambda(p.a_float, p.Q_a);
+    const auto full = mlambda(p.a_float, p.Q_a, with_z);
+    const auto dec = decorrelate(p.Q_a);
+    ASSERT_TRUE(plain.ok() && full.ok() && dec.ok());
+    EXPECT_EQ(plain->Z.size(), 0);
+    EXPECT_EQ(plain->candidates, full->candidates);
+    EXPECT_EQ(plain->squared_norms, full->squared_norms);
+    EXPECT_EQ(full->Z, dec->Z);
+  }
+}
+
 TEST(MlambdaTest, DeJongeTiberiusExample) {
   // Three-dimensional example of de Jonge & Tiberius (1996, LGR-12) and Teunissen's LAMBDA papers, numbers as
   // recalled from the literature: a_float = (5.45, 3.10, 2.97), Q_a below; the published ILS solution is (5, 3, 4).

@@ -30,9 +30,17 @@ struct AzEl {
 /// Azimuth and elevation of a direction given in local ENU (need not be unit length, must not be zero).
 [[nodiscard]] AzEl azimuth_elevation_from_enu(const Eigen::Vector3d& d_N);
 
+/// The elevation of azimuth_elevation_from_enu(d_N), without the azimuth (one atan2 less).
+[[nodiscard]] double elevation_from_enu(const Eigen::Vector3d& d_N);
+
 /// Azimuth and elevation of a satellite at p_E_sat seen from a receiver at p_E_rcv (geodetic `rcv`). A receiver at
 /// the Earth's centre (no position yet) sees every satellite at 90 deg elevation, as RTKLIB assumes.
 [[nodiscard]] AzEl azimuth_elevation(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv,
                                      const Eigen::Vector3d& p_E_sat);
+
+/// azimuth_elevation(p_E_rcv, rcv, p_E_sat).elevation_rad, with R_NE = rotation_enu_from_ecef(rcv) given: for many
+/// satellites seen from one receiver (the rotation's sines and cosines once, no azimuth).
+[[nodiscard]] double elevation_rad(const Eigen::Vector3d& p_E_rcv, const Geodetic& rcv, const Eigen::Matrix3d& R_NE,
+                                   const Eigen::Vector3d& p_E_sat);
 
 }  // namespace canyon::core

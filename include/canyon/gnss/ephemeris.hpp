@@ -80,10 +80,20 @@ class EphemerisStore {
   [[nodiscard]] const core::NavigationData& nav() const { return nav_; }
 
  private:
+  /// What selection reads of a usable (healthy, or use_unhealthy) Kepler record, kept contiguous per satellite so
+  /// that a selection, done three times per satellite state, walks a short array instead of the records.
+  struct KeplerCandidate {
+    core::GpsTime toe;
+    core::GpsTime transmission_time;
+    double max_age_s = 0.0;  // max(options.max_age_kepler_s, half the fit interval)
+    int index = 0;           // into nav_.kepler
+    bool galileo_inav = false;
+  };
+
   core::NavigationData nav_;
   EphemerisOptions options_;
-  // Indices per satellite (by SatelliteId::index()) into nav_ for fast selection.
-  std::vector<std::vector<int>> kepler_by_sat_;
+  // Per satellite (by SatelliteId::index()), in file order: Kepler candidates, GLONASS record indices into nav_.
+  std::vector<std::vector<KeplerCandidate>> kepler_by_sat_;
   std::vector<std::vector<int>> glonass_by_sat_;
 };
 

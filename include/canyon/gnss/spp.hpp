@@ -23,6 +23,7 @@
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/gnss/ephemeris.hpp"
+#include "canyon/gnss/satellite_states.hpp"
 
 namespace canyon::gnss {
 
@@ -62,8 +63,11 @@ struct SppSolution {
 };
 
 /// Solves one epoch. `initial_p_E_m`: a prior position (e.g. the last solution) to start from; the Earth's centre
-/// if none. Error (no file) with a reason on failure; the caller goes on with the next epoch.
+/// if none. `states`: the epoch's satellite states to take and leave for later users of the same epoch (its receive
+/// time must be epoch.time); computed here if null. Error (no file) with a reason on failure; the caller goes on
+/// with the next epoch.
 Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore& ephemerides, const SppOptions& options,
-                              const std::optional<Eigen::Vector3d>& initial_p_E_m = {});
+                              const std::optional<Eigen::Vector3d>& initial_p_E_m = {},
+                              EpochSatelliteStates* states = nullptr);
 
 }  // namespace canyon::gnss

@@ -55,6 +55,7 @@
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
 #include "canyon/gnss/ephemeris.hpp"
+#include "canyon/gnss/satellite_states.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/rtk/cycle_slip.hpp"
 #include "canyon/rtk/observables.hpp"
@@ -138,12 +139,22 @@ class RtkEngine {
     core::GpsTime last_seen;
   };
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
+  /// `rover_states`: the rover epoch's satellite states (shared with its single-point solution).
   [[nodiscard]] std::vector<SingleDiff> single_differences(const ReceiverObservables& rover,
-                                                           const ReceiverObservables& base) const;
+                                                           const ReceiverObservables& base,
+                                                           gnss::EpochSatelliteStates& rover_states) const;
   /// Runs both receivers' slip detectors and re-initialises the ambiguities that slipped; the base detector sees
   /// each base epoch once (a base slower than the rover repeats its epochs).
   void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
   void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
+  /// A keyed state to append: initial value and variance, uncorrelated with the other states.
+  struct NewState {
+    AmbiguityKey key;
+    double value = 0.0;
+    double variance = 0.0;
+  };
+  /// Appends the states in order, with one resize of x and P for all of them.
+  void add_states(const std::vector<NewState>& states);
   /// EKF update with the DD code and phase, with post-fit rejection; returns the number of DD phase rows used.
   int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
   struct PostFit {

@@ -12,10 +12,12 @@
 //   Inputs:    a_float  n-vector of float ambiguities [cycles], finite, n >= 1.
 //              Q_a      n x n covariance of a_float [cycles^2], symmetric (relative tolerance 1e-10, then
 //                       symmetrised) and positive definite (every pivot d_k > n eps max_i Q_ii).
-//              options  num_candidates m >= 1 (default 2), cap on search nodes (default 1e6).
+//              options  num_candidates m >= 1 (default 2), cap on search nodes (default 1e6), with_z (default
+//                       false: Z is not accumulated).
 //   Outputs:   candidates     n x m, column j = the (j+1)-th best integer vector in the a-space, exact integers
 //                             stored as double; squared_norms m-vector, ascending, (a_float - a_j)^T Q_a^{-1} (...).
-//              Z              n x n unimodular (integer, |det Z| = 1), z = Z^T a, Q_z = Z^T Q_a Z (decorrelated).
+//              Z              n x n unimodular (integer, |det Z| = 1), z = Z^T a, Q_z = Z^T Q_a Z (decorrelated);
+//                             only with options.with_z, else empty.
 //   Storage:   Eigen default, column major; indices 0-based; a's order is the caller's order throughout.
 //   Maths:     1. Q_z = L^T D L with L unit lower triangular, D = diag(d) (computed from the last row up, with the
 //                 symmetric pivoting of MLAMBDA: pivot k takes the smallest remaining diagonal element, so the
@@ -28,9 +30,9 @@
 //                 otherwise grow), and one pass after the last swap size-reduces all of L. The swaps and d are
 //                 those of MLAMBDA's reduction; the Gauss transformations skipped are those that cannot change a
 //                 swap decision or the search (Xie, Chang, Al Borno 2011, "Partial LLL reduction", Proc. IEEE
-//                 GLOBECOM; arXiv:1204.1398). Z accumulates all transformations; decorrelate() accumulates Z^{-1}
-//                 alongside, mlambda() logs the elementary operations instead and back-transforms only the m
-//                 candidates, a = Z^{-T} z (exact integer arithmetic either way).
+//                 GLOBECOM; arXiv:1204.1398). Z, when kept, accumulates all transformations; decorrelate()
+//                 accumulates Z^{-1} alongside, mlambda() logs the elementary operations instead and back-transforms
+//                 only the m candidates, a = Z^{-T} z (exact integer arithmetic either way).
 //              3. Search (Schnorr-Euchner enumeration, depth first, shrinking ellipsoid): with e = L^{-T}(z - z_hat),
 //                 ||.||^2 = sum_k (z_k - zbar_k)^2 / d_k, zbar_k = z_hat_k + sum_{j>k} L_jk (z_j - zbar_j)
 //                 (the conditional mean of z_k given z_{k+1..n}),
@@ -55,6 +57,7 @@ namespace canyon::rtk {
 struct MlambdaOptions {
   int num_candidates = 2;                     ///< m, number of best integer vectors returned, >= 1
   std::int64_t max_search_nodes = 1'000'000;  ///< cap on search steps (one step = one level move), > 0
+  bool with_z = false;  ///< also return Z (accumulating it costs about 15 % of a call; decorrelate() always has it)
 
   /// Ok, or the violated constraint, e.g. "Violated constraint: num_candidates >= 1".
   [[nodiscard]] Status validate() const;
@@ -64,7 +67,7 @@ struct MlambdaOptions {
 struct IntegerSearchResult {
   Eigen::MatrixXd candidates;             ///< n x m, column j = j-th best integer vector in the a-space (integers)
   Eigen::VectorXd squared_norms;          ///< m, ascending: (a_float - a_j)^T Q_a^{-1} (a_float - a_j)
-  Eigen::MatrixXd Z;                      ///< n x n unimodular decorrelation, z = Z^T a, Q_z = Z^T Q_a Z
+  Eigen::MatrixXd Z;                      ///< n x n unimodular decorrelation, z = Z^T a (options.with_z)
   Eigen::VectorXd conditional_variances;  ///< d of Q_z = L^T diag(d) L after the reduction [cycles^2]
   std::int64_t search_nodes = 0;          ///< search steps used (for diagnostics and benchmarks)
 };
