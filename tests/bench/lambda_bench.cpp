@@ -16,10 +16,10 @@
 //   build/tests/bench/bench_lambda          (rows ending in _median; --benchmark_filter=BM_Mlambda/n:30 for one size)
 // Results (median of 15 repetitions, us; shared 2-core machine, run-to-run cv 2-18 %, so treat +-20 % as noise):
 //                          n = 10   n = 20   n = 30
-//   realistic k = 1          7.2     38.6     35.3   (previous run: 51)
-//   realistic k = 5          4.6     24.1     44.2   (previous run: 51)
-//   realistic k = 20         4.2     13.7     34.1   (previous run: 29)
-//   single-epoch worst       8.1     73.4      863   (41k search nodes at n = 30: the search dominates)
+//   realistic k = 1          3.5     18.2     24.3   (before the reduction resumed at k + 1 and Z became optional: 35)
+//   realistic k = 5          3.2     15.8     30.3   (44)
+//   realistic k = 20         3.7     11.9     19.2   (34)
+//   single-epoch worst       5.7     49.0      821   (41k search nodes at n = 30: the search dominates)
 // Before the rewrite of the reduction (commit 888f135): realistic n = 30 k = 1 / 5 / 20: 82 / 79 / 42, single-epoch
 // n = 30: 993.
 
