@@ -405,6 +405,15 @@ void RtkEngine::remove_ambiguity(const AmbiguityKey& key) {
   }
 }
 
+void RtkEngine::clear_ambiguities() {
+  const int k = num_kinematic_states();
+  x_.conservativeResize(k);
+  P_.conservativeResize(k, k);
+  ambiguity_keys_.clear();
+  ambiguity_info_.clear();
+  last_fix_.clear();
+}
+
 void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp) {
   const double dt_s = last_time_ ? std::abs(t - *last_time_) : 0.0;
   const double var0 = options_.initial_position_sigma_m * options_.initial_position_sigma_m;
@@ -915,9 +924,7 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
     return out;
   }
 
-  if (options_.ar_mode == ArMode::Instantaneous) {
-    while (!ambiguity_keys_.empty()) remove_ambiguity(ambiguity_keys_.back());
-  }
+  if (options_.ar_mode == ArMode::Instantaneous) clear_ambiguities();
   time_update(rover.time, *spp);
   const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
   const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);

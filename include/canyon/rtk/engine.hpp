@@ -201,6 +201,8 @@ class RtkEngine {
   bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
   void add_ambiguity(const AmbiguityKey& key, double value, double variance);
   void remove_ambiguity(const AmbiguityKey& key);
+  /// Removes every keyed state (ambiguities, ionosphere) at once: instantaneous mode, each epoch.
+  void clear_ambiguities();
   [[nodiscard]] int ambiguity_index(const AmbiguityKey& key) const;
   [[nodiscard]] int num_kinematic_states() const { return options_.dynamics ? 9 : 3; }
 
