@@ -77,7 +77,28 @@ std::string glonass_ar_warning(const ProcessConfig& config, const io::RinexObsHe
   return w;
 }
 
-std::vector<std::string> header_lines(const ProcessConfig& config) {
+bool is_tracked(const core::SatelliteObs& sat) {
+  return std::any_of(sat.signals.begin(), sat.signals.end(), [](const core::SignalObs& s) {
+    return core::has_value(s.pseudorange_m) || core::has_value(s.carrier_phase_cyc);
+  });
+}
+
+/// Applies `exclude_most_observed`: the satellites join both modes' exclusion lists. Returns them.
+std::vector<core::SatelliteId> exclude_most_observed(ProcessConfig& config, const std::vector<core::ObsEpoch>& rover) {
+  if (config.exclude_most_observed <= 0) return {};
+  const core::ConstellationFlags& systems = config.mode == ProcessMode::Rtk
+                                                ? static_cast<const core::ConstellationFlags&>(config.rtk.observables)
+                                                : static_cast<const core::ConstellationFlags&>(config.spp);
+  std::vector<core::SatelliteId> sats = most_observed_satellites(rover, config.exclude_most_observed, systems);
+  for (const core::SatelliteId& sat : sats) {
+    config.spp.excluded.push_back(sat);
+    config.rtk.observables.excluded.push_back(sat);
+  }
+  return sats;
+}
+
+std::vector<std::string> header_lines(const ProcessConfig& config,
+                                      const std::vector<core::SatelliteId>& most_observed) {
   std::vector<std::string> lines;
   lines.push_back("program   : canyon process (mode " + mode_name(config.mode) + ")");
   lines.push_back("inp file  : " + config.rover_obs);
@@ -88,6 +109,12 @@ std::vector<std::string> header_lines(const ProcessConfig& config) {
   lines.emplace_back(mask);
   lines.push_back(std::string("ionos opt : ") + (config.spp.ionosphere_klobuchar ? "Broadcast" : "OFF"));
   lines.push_back(std::string("tropo opt : ") + (config.spp.troposphere_saastamoinen ? "Saastamoinen" : "OFF"));
+  if (!most_observed.empty()) {
+    std::string line = "excl sats : ";
+    for (const core::SatelliteId& sat : most_observed) line += sat.to_string() + " ";
+    line += "(the " + std::to_string(most_observed.size()) + " most observed)";
+    lines.push_back(std::move(line));
+  }
   return lines;
 }
 
@@ -197,9 +224,33 @@ Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
 
 }  // namespace
 
-Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn& progress) {
+std::vector<core::SatelliteId> most_observed_satellites(const std::vector<core::ObsEpoch>& epochs, int n,
+                                                        const core::ConstellationFlags& systems) {
+  std::vector<int> count(core::kMaxSatellites, 0);
+  std::vector<core::SatelliteId> seen(core::kMaxSatellites);
+  for (const core::ObsEpoch& epoch : epochs) {
+    for (const core::SatelliteObs& sat : epoch.sats) {
+      if (!sat.sat.valid() || !systems.uses(sat.sat.system) || !is_tracked(sat)) continue;
+      const int i = sat.sat.index();
+      ++count[i];
+      seen[i] = sat.sat;
+    }
+  }
+  std::vector<core::SatelliteId> sats;
+  for (int i = 0; i < core::kMaxSatellites; ++i) {
+    if (count[i] > 0) sats.push_back(seen[i]);
+  }
+  std::stable_sort(sats.begin(), sats.end(), [&count](const core::SatelliteId& a, const core::SatelliteId& b) {
+    return count[a.index()] > count[b.index()] || (count[a.index()] == count[b.index()] && a < b);
+  });
+  if (static_cast<int>(sats.size()) > n) sats.resize(static_cast<std::size_t>(std::max(n, 0)));
+  return sats;
+}
+
+Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress) {
   const auto start = std::chrono::steady_clock::now();
-  if (const std::string e = config.validate(); !e.empty()) return Error{e};
+  if (const std::string e = input_config.validate(); !e.empty()) return Error{e};
+  ProcessConfig config = input_config;
   ProcessSummary summary;
 
   auto nav = read_navigation(config.nav, summary.warnings);
@@ -210,6 +261,7 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
   if (!rover) return rover.error();
   summary.warnings.insert(summary.warnings.end(), rover->warnings.begin(), rover->warnings.end());
   keep_observations(*rover, config.rover_obs, summary.warnings);
+  summary.excluded_most_observed = exclude_most_observed(config, rover->epochs);
 
   std::optional<io::RinexObsFile> base;
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
@@ -239,7 +291,8 @@ Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn
     base = std::move(*base_file);
   }
 
-  auto pos = io::PosWriter::create(config.out, {config.coordinates, config.time_format, header_lines(config)});
+  auto pos = io::PosWriter::create(
+      config.out, {config.coordinates, config.time_format, header_lines(config, summary.excluded_most_observed)});
   if (!pos) return pos.error();
   Outputs outputs{std::move(*pos), std::nullopt};
   if (!config.nmea_out.empty()) {

@@ -150,6 +150,7 @@ std::string ProcessConfig::validate() const {
   if (rover_obs.empty()) return "a rover observation file is required (--rover or 'rover:')";
   if (nav.empty()) return "at least one navigation file is required (--nav or 'nav:')";
   if (out.empty()) return "a solution file is required (--out or 'out:')";
+  if (exclude_most_observed < 0) return "exclude_most_observed must be >= 0";
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
   if (mode == ProcessMode::Rtk) {
     if (base_obs.empty()) return "rtk needs a base observation file (--base or 'base:')";
@@ -202,6 +203,8 @@ Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::st
   c.out = resolve(c.out, file);
   top.get("nmea", c.nmea_out);
   c.nmea_out = resolve(c.nmea_out, file);
+  top.get("exclude_most_observed", c.exclude_most_observed);
+  if (c.exclude_most_observed < 0) top.fail("exclude_most_observed", "must be >= 0");
   {
     YamlMap output = top.sub("output");
     std::string coordinates = c.coordinates == io::PosCoordinates::Llh ? "llh" : "ecef";
@@ -292,6 +295,7 @@ std::string to_yaml(const ProcessConfig& c) {
   out << YAML::Key << "nav" << YAML::Value << YAML::Flow << c.nav;
   out << YAML::Key << "out" << YAML::Value << c.out;
   if (!c.nmea_out.empty()) out << YAML::Key << "nmea" << YAML::Value << c.nmea_out;
+  out << YAML::Key << "exclude_most_observed" << YAML::Value << c.exclude_most_observed;
   out << YAML::Key << "output" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "coordinates" << YAML::Value << (c.coordinates == io::PosCoordinates::Llh ? "llh" : "ecef");
   out << YAML::Key << "time_format" << YAML::Value

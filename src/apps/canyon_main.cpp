@@ -50,6 +50,7 @@ struct ProcessArgs {
   std::string base;
   std::string base_pos;
   std::string exclude_sats;
+  int exclude_most_observed = -1;
   std::vector<std::string> nav;
   std::string out;
   std::string nmea;
@@ -70,6 +71,9 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   cmd->add_option("--base", args.base, "Base RINEX observation file (rtk)");
   cmd->add_option("--base-pos", args.base_pos, "Base antenna ECEF X,Y,Z in metres (default: base file header)");
   cmd->add_option("--exclude-sats", args.exclude_sats, "Satellites never used, e.g. G05,E11");
+  cmd->add_option("--exclude-most-observed", args.exclude_most_observed,
+                  "Leave out the N satellites tracked in the most rover epochs (the paper's exclusion experiment)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--nav", args.nav, "RINEX navigation file (repeat for several)");
   cmd->add_option("--out", args.out, "Solution file, RTKLIB .pos format");
   cmd->add_option("--nmea", args.nmea, "Also write the solutions as NMEA GGA sentences to this file");
@@ -126,6 +130,7 @@ int run_process_command(const ProcessArgs& args) {
     config.spp.excluded = excluded;
     config.rtk.observables.excluded = excluded;
   }
+  if (args.exclude_most_observed >= 0) config.exclude_most_observed = args.exclude_most_observed;
   if (!args.nav.empty()) config.nav = args.nav;
   if (!args.out.empty()) config.out = args.out;
   if (!args.nmea.empty()) config.nmea_out = args.nmea;
@@ -160,6 +165,15 @@ int run_process_command(const ProcessArgs& args) {
   if (!args.verbose && summary->warnings.size() > kMaxWarningsShown) {
     std::fprintf(stderr, "canyon: warning: ... and %zu more input warnings (-v shows all)\n",
                  summary->warnings.size() - kMaxWarningsShown);
+  }
+  if (!summary->excluded_most_observed.empty() && !args.quiet) {
+    std::string sats;
+    for (const auto& sat : summary->excluded_most_observed) {
+      sats += ' ';
+      sats += sat.to_string();
+    }
+    std::fprintf(stderr, "canyon process: left out the %zu most observed satellites:%s\n",
+                 summary->excluded_most_observed.size(), sats.c_str());
   }
   if (args.verbose) {
     for (const std::string& note : summary->epoch_notes) std::fprintf(stderr, "canyon: %s\n", note.c_str());

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -77,6 +79,61 @@ TEST(CanyonCli, ProcessesRealDataAndSummarises) {
     if (!line.empty() && line[0] != '%') ++records;
   }
   EXPECT_EQ(records, 115);
+}
+
+/// Per record of a .pos file: "week tow" -> number of satellites (column 7 of a week/tow llh record).
+std::map<std::string, int> satellites_per_epoch(const fs::path& pos, std::string* header) {
+  std::map<std::string, int> out;
+  std::ifstream in(pos);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line[0] == '%') {
+      *header += line + "\n";
+      continue;
+    }
+    std::istringstream fields(line);
+    std::string week;
+    std::string tow;
+    double lat = 0;
+    double lon = 0;
+    double h = 0;
+    int q = 0;
+    int ns = 0;
+    if (fields >> week >> tow >> lat >> lon >> h >> q >> ns) out[week + " " + tow] = ns;
+  }
+  return out;
+}
+
+TEST(CanyonCli, ExcludeMostObservedLeavesOutThatManySatellitesEveryEpoch) {
+  if (!fs::exists(kGsiRover)) GTEST_SKIP() << "shared dataset not present: " << kGsiRover;
+  const fs::path dir = test::temp_dir("cli-most-observed");
+  const std::string inputs = " --mode spp --rover " + kGsiRover.string() + " --nav " + kGsiNav.string();
+  const auto all = canyon("process" + inputs + " --out " + (dir / "all.pos").string());
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  const auto fewer = canyon("process" + inputs + " --exclude-most-observed 2 --out " + (dir / "fewer.pos").string());
+  ASSERT_EQ(fewer.exit_code, 0) << fewer.output;
+  EXPECT_NE(fewer.output.find("left out the 2 most observed satellites: G"), std::string::npos) << fewer.output;
+  std::string header_all;
+  std::string header_fewer;
+  const auto ns_all = satellites_per_epoch(dir / "all.pos", &header_all);
+  const auto ns_fewer = satellites_per_epoch(dir / "fewer.pos", &header_fewer);
+  EXPECT_EQ(header_all.find("excl sats"), std::string::npos);
+  EXPECT_NE(header_fewer.find("(the 2 most observed)"), std::string::npos) << header_fewer;
+  // The two most observed satellites are tracked in (almost) every epoch: most solutions lose exactly two.
+  int compared = 0;
+  int lost_two = 0;
+  for (const auto& [time, ns] : ns_fewer) {
+    const auto it = ns_all.find(time);
+    if (it == ns_all.end()) continue;
+    ++compared;
+    EXPECT_GE(it->second - ns, 0) << time;
+    EXPECT_LE(it->second - ns, 2) << time;
+    if (it->second - ns == 2) ++lost_two;
+  }
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(lost_two, compared * 9 / 10);
+  const auto bad = canyon("process" + inputs + " --exclude-most-observed -1 --out " + (dir / "bad.pos").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
 
 TEST(CanyonCli, UnwritableOutputIsAnError) {

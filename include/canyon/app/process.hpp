@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "canyon/app/process_config.hpp"
+#include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
+#include "canyon/core/satellite.hpp"
 
 namespace canyon::app {
 
@@ -16,16 +18,23 @@ struct ProcessSummary {
   int fixed = 0;                      ///< epochs with a fixed (RTK) solution
   double wall_s = 0.0;                ///< wall-clock time of the whole run
   std::vector<std::string> warnings;  ///< recovered input defects, "file:line: what"
+  /// Satellites left out by `exclude_most_observed`, most observed first.
+  std::vector<core::SatelliteId> excluded_most_observed;
   /// Why epochs got no solution or one below the mode's best (first 100): "week tow: no solution: reason" or, in
   /// rtk mode, "week tow: float: ratio test failed" (status, then why it is not fixed).
   std::vector<std::string> epoch_notes;
 };
+
+/// The `n` satellites of the constellations in `systems` tracked (any code or phase) in the most epochs, most
+/// observed first; ties go to the lower satellite id. Fewer when fewer were tracked.
+[[nodiscard]] std::vector<core::SatelliteId> most_observed_satellites(const std::vector<core::ObsEpoch>& epochs, int n,
+                                                                      const core::ConstellationFlags& systems);
 
 /// Called after each epoch with (epochs done, epochs in total).
 using ProgressFn = std::function<void(int, int)>;
 
 /// Runs the configured mode over the whole input. Error (file and line) if an input cannot be read or the output
 /// cannot be written; an epoch that cannot be solved is counted and skipped.
-Result<ProcessSummary> run_process(const ProcessConfig& config, const ProgressFn& progress = {});
+Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress = {});
 
 }  // namespace canyon::app

@@ -10,6 +10,8 @@
 //   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
 //   out: SOL.pos                   # solution file (RTKLIB .pos format)
 //   nmea: SOL.nmea                 # also write NMEA GGA sentences (optional)
+//   exclude_most_observed: 0       # leave out the N satellites (of the used constellations) tracked in the most
+//                                  # rover epochs: the paper's satellite-exclusion experiment on real data
 //   output:
 //     coordinates: llh             # llh | ecef
 //     time_format: tow             # tow (GPST week, seconds) | calendar (yyyy/mm/dd hh:mm:ss.sss)
@@ -48,6 +50,7 @@ struct ProcessConfig {
   std::vector<std::string> nav;                      ///< navigation files
   std::string out;                                   ///< solution file
   std::string nmea_out;                              ///< NMEA GGA file written beside the .pos when set
+  int exclude_most_observed = 0;                     ///< leave out the N most observed satellites (>= 0)
   io::PosCoordinates coordinates = io::PosCoordinates::Llh;
   io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
   gnss::SppOptions spp;
