@@ -122,9 +122,9 @@ Result<Agreement> compare(const std::vector<core::Solution>& a, const std::vecto
 [[nodiscard]] std::string format_agreement(const Agreement& agreement, const std::string& name_a = "a",
                                            const std::string& name_b = "b");
 
-/// What `canyon evaluate` prints: reads `solution_path` (.pos), scores it against the truth given by
-/// `truth_spec` (see parse_truth_spec; empty: no truth), and, if `reference_path` is not empty, compares it with
-/// that second .pos file. Errors name the file and line.
+/// One file's text report (bench_eval_pos; `canyon evaluate` uses report.hpp): reads `solution_path` (.pos), scores
+/// it against the truth given by `truth_spec` (see parse_truth_spec; empty: no truth), and, if `reference_path` is
+/// not empty, compares it with that second .pos file. Errors name the file and line.
 Result<std::string> evaluate_files(const std::string& solution_path, const std::string& truth_spec,
                                    const EvalOptions& options = {}, const std::string& reference_path = {});
 
