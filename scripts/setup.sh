@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   clang-format clang-tidy
   rtklib
+  libxml2-utils
 )
 
 # One dpkg-query call for all packages; a package dpkg has never heard of prints nothing and counts as missing.

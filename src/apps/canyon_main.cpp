@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include "canyon/app/evaluate.hpp"
 #include "canyon/app/process.hpp"
 #include "canyon/app/process_config.hpp"
 #include "canyon/app/scenario_config.hpp"
@@ -244,6 +245,71 @@ int run_simulate_command(const SimulateArgs& args) {
   return 0;
 }
 
+struct EvaluateArgs {
+  canyon::app::EvaluateConfig config;
+  int epochs = 0;
+  bool quiet = false;
+};
+
+void add_evaluate_command(CLI::App& app, EvaluateArgs& args) {
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate",
+      "Score solutions (.pos, canyon's or RTKLIB's) against a truth, side by side: table, Markdown, JSON, SVG plots");
+  canyon::app::EvaluateConfig& c = args.config;
+  cmd->add_option("--truth", c.truth,
+                  "Truth: canyon truth.csv, Spirent PVA .csv, a .pos file, or a static point ecef:X,Y,Z (m) or "
+                  "llh:LAT,LON,H (deg, deg, m)")
+      ->required();
+  cmd->add_option("--solution", c.solutions, "Solution file, RTKLIB .pos in any of its output forms (repeat)")
+      ->required();
+  cmd->add_option("--label", c.labels,
+                  "Column title of the solution given in the same position (repeat; all or none; default: file names)");
+  auto* epochs = cmd->add_option("--epochs", args.epochs, "Number of rover epochs: the denominator of every rate")
+                     ->check(CLI::PositiveNumber);
+  cmd->add_option("--rover", c.rover_obs, "Rover RINEX observation file: its epochs are the rover epochs")
+      ->excludes(epochs);
+  cmd->add_option("--city", c.city, "City GeoJSON (canyon simulate's city.geojson) drawn under the trajectories");
+  cmd->add_option("--out-dir", c.out_dir,
+                  "Folder for evaluation.md, evaluation.json, trajectory.svg, ape.svg (default, when no output option "
+                  "is given: evaluation/ beside the first solution)");
+  cmd->add_option("--markdown", c.markdown, "Markdown table file (instead of DIR/evaluation.md)");
+  cmd->add_option("--json", c.json, "JSON file (instead of DIR/evaluation.json)");
+  cmd->add_option("--trajectory-svg", c.trajectory_svg, "Trajectory plot (instead of DIR/trajectory.svg)");
+  cmd->add_option("--ape-svg", c.ape_svg, "Error-over-time plot (instead of DIR/ape.svg)");
+  cmd->add_option("--wrong-fix-m", c.wrong_fix_threshold_m,
+                  "Fixed epochs with a larger 3D error are wrong fixes (m), default 0.10")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("-q,--quiet", args.quiet, "No table and no list of files written");
+  cmd->footer(
+      "Rover epochs (every rate's denominator): --epochs N, else the epochs of --rover OBS, else, for a truth "
+      "trajectory, its epochs within the solutions' time span joined with the solutions' epochs (canyon simulate's "
+      "truth.csv has one row per rover epoch), else (static truth) the union of the solutions' epochs.\n"
+      "Rates: fixed/float/single/fill-in (Q 7) epochs and solved epochs (availability) over rover epochs; wrong-fix "
+      "rate over fixed epochs with truth. APE: 3D and horizontal error (ENU at the truth, truth interpolated to each "
+      "epoch); solved epochs the truth does not cover (its gaps) are counted as 'epochs without truth'.\n"
+      "Exit status: 0 success, 1 bad input (file and line named), 2 bad command line.");
+}
+
+int run_evaluate_command(EvaluateArgs& args) {
+  if (args.epochs > 0) args.config.epochs = args.epochs;
+  if (const std::string broken = args.config.validate(); !broken.empty()) {
+    std::cerr << "canyon: error: " << broken << "\n";
+    return kExitUsage;
+  }
+  auto summary = canyon::app::run_evaluate(args.config);
+  if (!summary) {
+    std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
+    return kExitInput;
+  }
+  for (const std::string& w : summary->warnings) std::fprintf(stderr, "canyon: warning: %s\n", w.c_str());
+  if (!args.quiet) {
+    std::fputs(summary->table.c_str(), stdout);
+    std::fflush(stdout);  // the table before the list of files when both go to one pipe
+    for (const std::string& path : summary->written) std::fprintf(stderr, "canyon evaluate: wrote %s\n", path.c_str());
+  }
+  return 0;
+}
+
 int run_main(int argc, char** argv) {
   CLI::App app{"canyon: centimetre-level GNSS carrier-phase positioning fused with visual-inertial odometry"};
   app.require_subcommand(1);
@@ -251,6 +317,8 @@ int run_main(int argc, char** argv) {
   add_process_command(app, process_args);
   SimulateArgs simulate_args;
   add_simulate_command(app, simulate_args);
+  EvaluateArgs evaluate_args;
+  add_evaluate_command(app, evaluate_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -263,6 +331,7 @@ int run_main(int argc, char** argv) {
   }
   if (app.got_subcommand("process")) return run_process_command(process_args);
   if (app.got_subcommand("simulate")) return run_simulate_command(simulate_args);
+  if (app.got_subcommand("evaluate")) return run_evaluate_command(evaluate_args);
   return kExitUsage;
 }
 

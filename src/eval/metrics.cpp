@@ -17,14 +17,44 @@ struct EpochError {
   Eigen::Vector3d d_N_m = Eigen::Vector3d::Zero();
 };
 
+double percentile_sorted(const std::vector<double>& sorted, double fraction) {
+  const double rank = fraction * static_cast<double>(sorted.size() - 1);
+  const auto below = static_cast<std::size_t>(std::floor(rank));
+  const std::size_t above = std::min(below + 1, sorted.size() - 1);
+  const double weight = rank - static_cast<double>(below);
+  return sorted[below] + weight * (sorted[above] - sorted[below]);
+}
+
+/// The distribution of `values` (sorted in place).
+ErrorDistribution distribution(std::vector<double>& values) {
+  ErrorDistribution d;
+  if (values.empty()) return d;
+  std::sort(values.begin(), values.end());
+  const auto n = static_cast<double>(values.size());
+  double sum = 0.0;
+  double sum_sq = 0.0;
+  for (const double v : values) {
+    sum += v;
+    sum_sq += v * v;
+  }
+  d.mean_m = sum / n;
+  d.rmse_m = std::sqrt(sum_sq / n);
+  double sum_sq_dev = 0.0;
+  for (const double v : values) sum_sq_dev += (v - d.mean_m) * (v - d.mean_m);
+  d.std_m = std::sqrt(sum_sq_dev / n);
+  d.median_m = percentile_sorted(values, 0.5);
+  d.p95_m = percentile_sorted(values, 0.95);
+  d.max_m = values.back();
+  return d;
+}
+
 /// Accumulates errors of one set of epochs.
 class ErrorAccumulator {
  public:
   void add(const Eigen::Vector3d& d_N_m) {
     const double horizontal_m = std::hypot(d_N_m.x(), d_N_m.y());
-    sum_sq_horizontal_m2_ += horizontal_m * horizontal_m;
     sum_sq_vertical_m2_ += d_N_m.z() * d_N_m.z();
-    max_horizontal_m_ = std::max(max_horizontal_m_, horizontal_m);
+    errors_horizontal_m_.push_back(horizontal_m);
     errors_3d_m_.push_back(d_N_m.norm());
   }
 
@@ -32,29 +62,20 @@ class ErrorAccumulator {
     ErrorStats s;
     s.count = static_cast<int>(errors_3d_m_.size());
     if (s.count == 0) return s;
-    const double n = s.count;
-    s.horizontal_rmse_m = std::sqrt(sum_sq_horizontal_m2_ / n);
-    s.horizontal_max_m = max_horizontal_m_;
-    s.vertical_rmse_m = std::sqrt(sum_sq_vertical_m2_ / n);
-    s.rmse_3d_m = std::sqrt((sum_sq_horizontal_m2_ + sum_sq_vertical_m2_) / n);
-    std::sort(errors_3d_m_.begin(), errors_3d_m_.end());
-    s.max_3d_m = errors_3d_m_.back();
-    s.p95_3d_m = percentile_sorted(errors_3d_m_, 0.95);
+    s.ape_3d = distribution(errors_3d_m_);
+    s.ape_horizontal = distribution(errors_horizontal_m_);
+    s.horizontal_rmse_m = s.ape_horizontal.rmse_m;
+    s.horizontal_max_m = s.ape_horizontal.max_m;
+    s.vertical_rmse_m = std::sqrt(sum_sq_vertical_m2_ / s.count);
+    s.rmse_3d_m = s.ape_3d.rmse_m;
+    s.max_3d_m = s.ape_3d.max_m;
+    s.p95_3d_m = s.ape_3d.p95_m;
     return s;
   }
 
  private:
-  static double percentile_sorted(const std::vector<double>& sorted, double fraction) {
-    const double rank = fraction * static_cast<double>(sorted.size() - 1);
-    const auto below = static_cast<std::size_t>(std::floor(rank));
-    const std::size_t above = std::min(below + 1, sorted.size() - 1);
-    const double weight = rank - static_cast<double>(below);
-    return sorted[below] + weight * (sorted[above] - sorted[below]);
-  }
-
-  double sum_sq_horizontal_m2_ = 0.0;
   double sum_sq_vertical_m2_ = 0.0;
-  double max_horizontal_m_ = 0.0;
+  std::vector<double> errors_horizontal_m_;
   std::vector<double> errors_3d_m_;
 };
 
@@ -167,6 +188,7 @@ Result<SolutionStats> evaluate(const std::vector<core::Solution>& solutions, con
     st.error = class_errors[k].finish();
   }
   stats.overall = overall_errors.finish();
+  if (truth != nullptr) stats.epochs_without_truth = stats.epochs_with_solution - stats.epochs_with_truth;
   return stats;
 }
 

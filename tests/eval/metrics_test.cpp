@@ -80,6 +80,32 @@ TEST(Evaluate, ErrorsOfFixedEpochsInEnuAtTheTruth) {
   EXPECT_NEAR(e.p95_3d_m, 0.12 + 0.85 * (1.0 - 0.12), kTolM);
 }
 
+TEST(Evaluate, ApeDistributionOfFixedEpochs) {
+  const Truth truth = Truth::constant(core::geodetic_to_ecef(kOrigin));
+  const auto stats = evaluate(mixed_set(), truth);
+  ASSERT_TRUE(stats.ok());
+  // 3D 0, 0.05, 0.12, 1.0; horizontal 0, 0, 0.05, 0.6
+  const ErrorDistribution& d = stats->fixed().error.ape_3d;
+  const double mean = (0.05 + 0.12 + 1.0) / 4;
+  const double mean_sq = (0.0025 + 0.0144 + 1.0) / 4;
+  EXPECT_NEAR(d.mean_m, mean, kTolM);
+  EXPECT_NEAR(d.rmse_m, std::sqrt(mean_sq), kTolM);
+  EXPECT_NEAR(d.median_m, (0.05 + 0.12) / 2, kTolM);
+  EXPECT_NEAR(d.std_m, std::sqrt(mean_sq - mean * mean), kTolM);
+  EXPECT_NEAR(d.max_m, 1.0, kTolM);
+  EXPECT_NEAR(d.p95_m, stats->fixed().error.p95_3d_m, kTolM);
+  const ErrorDistribution& h = stats->fixed().error.ape_horizontal;
+  EXPECT_NEAR(h.mean_m, 0.65 / 4, kTolM);
+  EXPECT_NEAR(h.median_m, 0.025, kTolM);
+  EXPECT_NEAR(h.max_m, 0.6, kTolM);
+  EXPECT_NEAR(h.rmse_m, stats->fixed().error.horizontal_rmse_m, kTolM);
+  // Epochs without truth: none for a static truth, all without one.
+  EXPECT_EQ(stats->epochs_without_truth, 0);
+  const auto no_truth = evaluate(mixed_set(), nullptr);
+  ASSERT_TRUE(no_truth.ok());
+  EXPECT_EQ(no_truth->epochs_without_truth, 0);
+}
+
 TEST(Evaluate, ErrorsOfOtherClassesAndOverall) {
   const Truth truth = Truth::constant(core::geodetic_to_ecef(kOrigin));
   const auto stats = evaluate(mixed_set(), truth);
@@ -142,6 +168,7 @@ TEST(Evaluate, EpochsOutsideTheTruthSpanHaveNoError) {
   ASSERT_TRUE(stats.ok());
   EXPECT_EQ(stats->epochs_with_solution, 9);
   EXPECT_EQ(stats->epochs_with_truth, 2);  // t0 (single) and t0 + 1 (float)
+  EXPECT_EQ(stats->epochs_without_truth, 7);
   EXPECT_EQ(stats->fixed().error.count, 0);
 }
 

@@ -32,6 +32,18 @@ struct EvalOptions {
   [[nodiscard]] std::string validate() const;
 };
 
+/// Distribution of one error magnitude over a set of epochs (absolute position error, APE): all zero when empty.
+/// Median and p95 interpolate linearly between order statistics (as the 95th percentile above); std is the
+/// population standard deviation (divided by n), so that rmse^2 = mean^2 + std^2.
+struct ErrorDistribution {
+  double rmse_m = 0.0;
+  double mean_m = 0.0;
+  double median_m = 0.0;
+  double std_m = 0.0;
+  double max_m = 0.0;
+  double p95_m = 0.0;
+};
+
 /// Position error statistics over a set of epochs (all zero when count == 0).
 struct ErrorStats {
   int count = 0;                   ///< epochs with a truth position
@@ -40,7 +52,9 @@ struct ErrorStats {
   double vertical_rmse_m = 0.0;  ///< RMS of u
   double rmse_3d_m = 0.0;
   double max_3d_m = 0.0;
-  double p95_3d_m = 0.0;  ///< 95th percentile of the 3D error
+  double p95_3d_m = 0.0;             ///< 95th percentile of the 3D error
+  ErrorDistribution ape_3d;          ///< of |d_N|
+  ErrorDistribution ape_horizontal;  ///< of hypot(e, n)
 };
 
 /// Status classes counted separately: canyon's four (RTKLIB's Q 1, 2, 5, 7) and everything else RTKLIB writes
@@ -61,6 +75,7 @@ struct SolutionStats {
   int epochs_in = 0;             ///< input epochs (EvalOptions::epochs_in, else solution records)
   int epochs_with_solution = 0;  ///< records with a status other than None
   int epochs_with_truth = 0;     ///< solutions for which the truth has a position
+  int epochs_without_truth = 0;  ///< solutions at times the truth does not cover (outside its span, in its gaps)
   std::array<StatusStats, kNumStatusClasses> by_class{};
   ErrorStats overall;   ///< all solutions with truth, every status
   int wrong_fixes = 0;  ///< fixed epochs with 3D error > wrong_fix_threshold_m
@@ -107,9 +122,9 @@ Result<Agreement> compare(const std::vector<core::Solution>& a, const std::vecto
 [[nodiscard]] std::string format_agreement(const Agreement& agreement, const std::string& name_a = "a",
                                            const std::string& name_b = "b");
 
-/// What `canyon evaluate` prints: reads `solution_path` (.pos), scores it against the truth given by
-/// `truth_spec` (see parse_truth_spec; empty: no truth), and, if `reference_path` is not empty, compares it with
-/// that second .pos file. Errors name the file and line.
+/// One file's text report (bench_eval_pos; `canyon evaluate` uses report.hpp): reads `solution_path` (.pos), scores
+/// it against the truth given by `truth_spec` (see parse_truth_spec; empty: no truth), and, if `reference_path` is
+/// not empty, compares it with that second .pos file. Errors name the file and line.
 Result<std::string> evaluate_files(const std::string& solution_path, const std::string& truth_spec,
                                    const EvalOptions& options = {}, const std::string& reference_path = {});
 
