@@ -9,12 +9,9 @@
 #include <set>
 #include <sstream>
 
+#include "canyon/app/shipped_config.hpp"
 #include "canyon/app/yaml_reader.hpp"
 #include "canyon/core/constants.hpp"
-
-#ifndef CANYON_SCENARIO_DIR
-#define CANYON_SCENARIO_DIR ""
-#endif
 
 namespace canyon::app {
 namespace {
@@ -460,10 +457,7 @@ void write_scenario_body(Writer& w, const Scenario& s) {
 
 std::vector<fs::path> scenario_folders() {
   std::vector<fs::path> folders;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) folders.push_back(exe.parent_path() / ".." / "config" / "scenarios");
-  if (!std::string(CANYON_SCENARIO_DIR).empty()) folders.emplace_back(CANYON_SCENARIO_DIR);
+  for (const std::string& config : shipped_config_folders()) folders.push_back(fs::path(config) / "scenarios");
   return folders;
 }
 

@@ -57,8 +57,8 @@ TEST(MostObservedSatellites, OnlyUsedConstellationsAndTrackedSignalsCount) {
   core::SatelliteObs phase_only = tracked(G, 4);
   phase_only.signals[0].pseudorange_m = core::kNoValue;
   phase_only.signals[0].carrier_phase_cyc = 1.0e8;
-  const auto data = epochs({{tracked(R, 1), untracked, phase_only}, {tracked(R, 1), untracked, phase_only},
-                            {tracked(R, 1), tracked(E, 5)}});
+  const auto data = epochs(
+      {{tracked(R, 1), untracked, phase_only}, {tracked(R, 1), untracked, phase_only}, {tracked(R, 1), tracked(E, 5)}});
   core::ConstellationFlags no_glonass;
   no_glonass.use_glonass = false;
   const auto sats = most_observed_satellites(data, 5, no_glonass);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # canyon RTK and RTKLIB side by side on generated scenarios (canyon simulate). For each scenario and seed: generate
 # into a temp folder, run
-#   RTKLIB  rnx2rtkp -k tests/bench/rtklib-sim.conf (kinematic, forward, continuous AR, ratio 3, L1+L2, 15 deg mask,
+#   RTKLIB  rnx2rtkp -k config/rtklib/sim.conf (kinematic, forward, continuous AR, ratio 3, L1+L2, 15 deg mask,
 #           base position from the base header, ionosphere est-stec) and the same with pos1-ionoopt=brdc;
 #   canyon  canyon process --mode rtk --config config/rtk.yaml (ionosphere: off) and the same with
 #           ionosphere: estimate;
@@ -22,7 +22,7 @@ scenarios=("$@")
 ((${#scenarios[@]} > 0)) || scenarios=(open-sky light-blocked urban-moderate urban-severe)
 canyon=$build/canyon
 eval_pos=$build/tests/bench/bench_eval_pos
-conf=$root/tests/bench/rtklib-sim.conf
+conf=$root/config/rtklib/sim.conf
 
 [[ -x $canyon ]] || { echo "error: $canyon not built (run scripts/build.sh)" >&2; exit 2; }
 [[ -x $eval_pos ]] || { echo "error: $eval_pos not built (CANYON_BUILD_BENCHMARKS=ON)" >&2; exit 2; }

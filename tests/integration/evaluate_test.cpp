@@ -326,7 +326,7 @@ TEST(EvaluateCli, SimulateProcessRtklibEvaluate) {
              (sim / "base.obs").string() + " --nav " + (sim / "nav.rnx").string() + " --out " +
              (dir / "canyon.pos").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string conf = std::string(CANYON_SOURCE_DIR) + "/tests/bench/rtklib-sim.conf";
+  const std::string conf = std::string(CANYON_SOURCE_DIR) + "/config/rtklib/sim.conf";
   r = test::run_command("rnx2rtkp -k " + conf + " -o " + (dir / "rtklib.pos").string() + " " +
                         (sim / "rover.obs").string() + " " + (sim / "base.obs").string() + " " +
                         (sim / "nav.rnx").string());

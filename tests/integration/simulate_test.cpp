@@ -48,7 +48,7 @@ eval::SolutionStats score(const fs::path& pos, const fs::path& dir) {
 
 fs::path run_rtklib(const fs::path& dir) {
   fs::path pos = dir / "rtklib.pos";
-  const std::string conf = std::string(CANYON_SOURCE_DIR) + "/tests/bench/rtklib-sim.conf";
+  const std::string conf = std::string(CANYON_SOURCE_DIR) + "/config/rtklib/sim.conf";
   const auto r = test::run_command("rnx2rtkp -k " + conf + " -o " + pos.string() + " " + (dir / "rover.obs").string() +
                                    " " + (dir / "base.obs").string() + " " + (dir / "nav.rnx").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;

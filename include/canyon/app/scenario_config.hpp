@@ -32,7 +32,7 @@ Result<sim::Scenario> load_scenario(const std::string& path);
 [[nodiscard]] std::string scenario_to_yaml(const sim::Scenario& scenario, const std::string& truth_yaml = {});
 
 /// The path of a scenario given as NAME (a file NAME.yaml in a scenario folder) or as a file path. Scenario folders:
-/// `<executable folder>/../config/scenarios`, then `<source tree>/config/scenarios`. Error naming the shipped
+/// `scenarios/` in each shipped configuration folder (canyon/app/shipped_config.hpp). Error naming the shipped
 /// scenarios if nothing matches.
 Result<std::string> find_scenario_file(const std::string& name_or_file);
 
