@@ -1,33 +1,20 @@
 #!/usr/bin/env bash
-# Sets canyon up on a fresh Debian 12 machine (packages, build) and runs its main job on the built-in default:
-# single-point positioning of the real cssrlib-kinematic-doy265 drive (../shared/data beside the repository),
-# written to out/spp-cssrlib-kinematic.pos in RTKLIB's .pos format.
-# Usage: scripts/quickstart.sh [BUILD_DIR]      (default: <repo>/build)
+# Sets canyon up on a fresh Debian 12 machine (packages, build) and runs its main job on the built-in default, with
+# no external data: `canyon demo` generates the urban-severe street-canyon scenario (10 minutes, pedestrian, 20 km
+# base), processes it with canyon's SPP and RTK modes and with RTKLIB's rnx2rtkp, scores all three against the
+# scenario's exact truth, prints the side-by-side table and writes the plots into out/demo/.
+# Usage: scripts/quickstart.sh [BUILD_DIR] [canyon demo options...]     (default: <repo>/build)
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="$(realpath -m "${1:-${repo_root}/build}")"
-config="${repo_root}/config/spp-cssrlib-kinematic.yaml"
-data="${repo_root}/../shared/data/cssrlib-kinematic-doy265"
+shift || true
 
 echo "== setup: Debian packages"
 bash "${repo_root}/scripts/setup.sh"
 echo "== build: ${build_dir}"
 bash "${repo_root}/scripts/build.sh" "${build_dir}"
 
-if [[ ! -d "${data}" ]]; then
-  echo "error: the default job reads the shared dataset ${data}, which is not present." >&2
-  echo "       Put the shared/ folder beside this repository, or run your own data:" >&2
-  echo "       ${build_dir}/canyon process --mode spp --rover ROVER.obs --nav NAV --out SOL.pos" >&2
-  exit 1
-fi
-
-echo "== canyon process --config config/spp-cssrlib-kinematic.yaml"
+echo "== canyon demo --out out/demo $*"
 cd "${repo_root}"
-"${build_dir}/canyon" process --config "${config}"
-out="${repo_root}/out/spp-cssrlib-kinematic.pos"
-echo
-echo "First solutions (GPST week, seconds, latitude, longitude, height, Q=5 single point, satellites, sigmas):"
-grep -v '^%' "${out}" | head -n 5
-echo "..."
-echo "Solution file: ${out}"
+"${build_dir}/canyon" demo --out out/demo "$@"

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include "canyon/app/demo.hpp"
 #include "canyon/app/evaluate.hpp"
 #include "canyon/app/process.hpp"
 #include "canyon/app/process_config.hpp"
@@ -310,6 +311,57 @@ int run_evaluate_command(EvaluateArgs& args) {
   return 0;
 }
 
+struct DemoArgs {
+  canyon::app::DemoConfig config;
+  std::int64_t seed = -1;
+  double duration_s = -1.0;
+  bool no_rtklib = false;
+};
+
+void add_demo_command(CLI::App& app, DemoArgs& args) {
+  CLI::App* cmd = app.add_subcommand(
+      "demo",
+      "canyon's main job, no external data: generate urban-severe, process it with SPP, RTK and RTKLIB, evaluate");
+  canyon::app::DemoConfig& c = args.config;
+  cmd->add_option("--scenario", c.scenario, "Shipped scenario name or a FILE.yaml (default urban-severe)");
+  cmd->add_option("--seed", args.seed, "Random seed (default: the scenario's)")->check(CLI::Range(0LL, 1LL << 53));
+  cmd->add_option("--duration", args.duration_s, "Duration in seconds (default: the scenario's, 600)")
+      ->check(CLI::Range(1.0, 86400.0));
+  cmd->add_option("--out", c.out_dir, "Output folder (default out/demo; created if needed)");
+  cmd->add_option("--rtk-config", c.rtk_config,
+                  "canyon's RTK configuration, a file in config/ (default " + c.rtk_config + ")");
+  cmd->add_flag("--no-rtklib", args.no_rtklib, "Do not run RTKLIB's rnx2rtkp as the baseline");
+  cmd->add_option("--rtklib-program", c.rtklib_program, "RTKLIB's rnx2rtkp to run (default: rnx2rtkp on PATH)");
+  cmd->footer(
+      "Writes DIR/scenario/ (canyon simulate's files), DIR/spp.pos, DIR/rtk.pos, DIR/rtklib.pos (+ rtklib.log), and "
+      "canyon evaluate's DIR/evaluation.md, evaluation.json, trajectory.svg, ape.svg; prints the side-by-side table.\n"
+      "Exit status: 0 success, 1 a stage failed (named), 2 bad command line or scenario.");
+}
+
+int run_demo_command(DemoArgs& args) {
+  canyon::app::DemoConfig& c = args.config;
+  if (args.seed >= 0) c.seed = static_cast<std::uint64_t>(args.seed);
+  if (args.duration_s > 0.0) c.duration_s = args.duration_s;
+  c.run_rtklib = !args.no_rtklib;
+  auto scenario = canyon::app::find_scenario_file(c.scenario);
+  if (!scenario) {
+    std::cerr << "canyon: error: " << scenario.error().to_string() << "\n";
+    return kExitUsage;
+  }
+  auto summary = canyon::app::run_demo(
+      c, [](const std::string& stage) { std::fprintf(stderr, "canyon demo: %s\n", stage.c_str()); });
+  if (!summary) {
+    std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
+    return kExitInput;
+  }
+  for (const std::string& note : summary->notes) std::fprintf(stderr, "canyon demo: note: %s\n", note.c_str());
+  std::fflush(stderr);
+  std::fputs(summary->table.c_str(), stdout);
+  std::fflush(stdout);
+  for (const std::string& path : summary->written) std::fprintf(stderr, "canyon demo: wrote %s\n", path.c_str());
+  return 0;
+}
+
 int run_main(int argc, char** argv) {
   CLI::App app{"canyon: centimetre-level GNSS carrier-phase positioning fused with visual-inertial odometry"};
   app.require_subcommand(1);
@@ -319,6 +371,8 @@ int run_main(int argc, char** argv) {
   add_simulate_command(app, simulate_args);
   EvaluateArgs evaluate_args;
   add_evaluate_command(app, evaluate_args);
+  DemoArgs demo_args;
+  add_demo_command(app, demo_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -332,6 +386,7 @@ int run_main(int argc, char** argv) {
   if (app.got_subcommand("process")) return run_process_command(process_args);
   if (app.got_subcommand("simulate")) return run_simulate_command(simulate_args);
   if (app.got_subcommand("evaluate")) return run_evaluate_command(evaluate_args);
+  if (app.got_subcommand("demo")) return run_demo_command(demo_args);
   return kExitUsage;
 }
 
