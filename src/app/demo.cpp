@@ -2,15 +2,15 @@
 
 #include "canyon/app/demo.hpp"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "canyon/app/evaluate.hpp"
 #include "canyon/app/process.hpp"
@@ -40,8 +40,7 @@ Result<sim::Scenario> demo_scenario(const DemoConfig& config) {
 }
 
 /// Runs canyon process in `mode` on the scenario in `scenario_dir`, writing `out`.
-Result<ProcessSummary> process_scenario(ProcessConfig config, const std::string& scenario_dir,
-                                        const std::string& out) {
+Result<ProcessSummary> process_scenario(ProcessConfig config, const std::string& scenario_dir, const std::string& out) {
   config.rover_obs = path_in(scenario_dir, "rover.obs");
   config.base_obs = path_in(scenario_dir, "base.obs");
   config.nav = {path_in(scenario_dir, "nav.rnx")};

@@ -35,8 +35,8 @@ Result<std::string> find_shipped_config(const std::string& relative) {
     if (!searched.empty()) searched += ", ";
     searched += folder;
   }
-  return Error{"shipped configuration '" + relative + "' not found (searched: " +
-               (searched.empty() ? std::string("no folder") : searched) + ")"};
+  return Error{"shipped configuration '" + relative +
+               "' not found (searched: " + (searched.empty() ? std::string("no folder") : searched) + ")"};
 }
 
 }  // namespace canyon::app

@@ -22,21 +22,21 @@
 namespace canyon::app {
 
 struct DemoConfig {
-  std::string scenario = "urban-severe";       ///< shipped scenario name or a scenario file
-  std::optional<std::uint64_t> seed;           ///< default: the scenario's
-  std::optional<double> duration_s;            ///< default: the scenario's
-  std::string out_dir = "out/demo";            ///< created if needed
-  std::string rtk_config = "rtk.yaml";          ///< canyon's RTK configuration, a file in the shipped config/
+  std::string scenario = "urban-severe";          ///< shipped scenario name or a scenario file
+  std::optional<std::uint64_t> seed;              ///< default: the scenario's
+  std::optional<double> duration_s;               ///< default: the scenario's
+  std::string out_dir = "out/demo";               ///< created if needed
+  std::string rtk_config = "rtk.yaml";            ///< canyon's RTK configuration, a file in the shipped config/
   std::string rtklib_config = "rtklib/sim.conf";  ///< RTKLIB's option file, in the shipped config/
-  bool run_rtklib = true;                      ///< run `rnx2rtkp` (skipped with a note when not installed)
-  std::string rtklib_program = "rnx2rtkp";     ///< found on PATH
+  bool run_rtklib = true;                         ///< run `rnx2rtkp` (skipped with a note when not installed)
+  std::string rtklib_program = "rnx2rtkp";        ///< found on PATH
 };
 
 struct DemoSummary {
   SimulateSummary simulation;
-  std::string table;                  ///< canyon evaluate's side-by-side table
-  std::vector<std::string> notes;     ///< e.g. RTKLIB not installed
-  std::vector<std::string> written;   ///< result files (the scenario's files are in DIR/scenario)
+  std::string table;                 ///< canyon evaluate's side-by-side table
+  std::vector<std::string> notes;    ///< e.g. RTKLIB not installed
+  std::vector<std::string> written;  ///< result files (the scenario's files are in DIR/scenario)
 };
 
 /// Called with one line per stage ("simulate urban-severe (seed 1, 600 s)").
