@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include <sys/stat.h>
 #include <zlib.h>
 
 namespace canyon::io {
@@ -30,7 +31,19 @@ Result<TextReader> TextReader::open(const std::string& path) {
     return Error{std::string("cannot open file: ") + std::strerror(errno), path, 0};
   }
   gzbuffer(impl->file, 1 << 17);
-  return TextReader(std::move(impl), path);
+  TextReader reader(std::move(impl), path);
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && info.st_size > 0)
+    reader.file_size_ = static_cast<std::uint64_t>(info.st_size);
+  return reader;
+}
+
+double TextReader::fraction_read() const {
+  if (file_size_ == 0 || impl_ == nullptr || impl_->file == nullptr) return 0.0;
+  if (ended_) return 1.0;
+  const auto offset = gzoffset(impl_->file);
+  if (offset <= 0) return 0.0;
+  return std::min(1.0, static_cast<double>(offset) / static_cast<double>(file_size_));
 }
 
 bool TextReader::fill() {

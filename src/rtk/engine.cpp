@@ -19,9 +19,8 @@ namespace {
 using core::Constellation;
 using core::SatelliteId;
 
-constexpr double kMaxBaseTimeAheadS = 0.05;
-constexpr std::size_t kPrunedSubsets = 3;  // partial fixing prunes at most this many group-excluded subsets  // base
-                                           // tags up to this much after the rover tag still count as "now"
+constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
+constexpr std::size_t kPrunedSubsets = 3;    // partial fixing prunes at most this many group-excluded subsets
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {
@@ -852,21 +851,39 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
     out.note = "too few ambiguities to fix: " + std::to_string(all.size());
     return false;
   }
-  std::optional<Fix> best = try_fix(all, options_.min_fix_ambiguities);
-  if (best) out.solution.ratio = std::min(best->ratio, 999.9);
-  if (!best || !accepted(*best)) {
-    const std::string why = !best                                    ? "integer search failed"
-                            : best->ratio < options_.ratio_threshold ? "ratio test failed"
-                                                                     : "success rate too low";
-    // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the
-    // float ambiguities left out, which are biased when the full set fails.
-    const auto min_size = static_cast<int>(std::ceil(options_.min_partial_fraction * static_cast<double>(all.size())));
-    best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
-    if (!best) {
-      out.note = why;
-      return false;
-    }
+  // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the
+  // float ambiguities left out, which are biased when the full set fails.
+  const auto min_size = static_cast<int>(std::ceil(options_.min_partial_fraction * static_cast<double>(all.size())));
+  std::vector<DdKey> all_keys;
+  all_keys.reserve(all.size());
+  for (const auto& pair : all) all_keys.push_back(dd_key(pair));
+  // The same full set failed at the last epoch and a subset was fixed: the subset is tried first, and the full set
+  // again only every kFullSetRetryEpochs epochs (or when the set changes). One epoch more of data seldom turns a
+  // failing set around, and each integer search of the full set costs as much as the rest of the epoch.
+  std::optional<Fix> best;
+  if (options_.partial_ar && all_keys == failed_full_set_ && epochs_since_full_set_ < kFullSetRetryEpochs) {
+    best = last_subset_fix(all, min_size);
+    ++epochs_since_full_set_;
+  }
+  if (best) {
     out.solution.ratio = std::min(best->ratio, 999.9);
+  } else {
+    best = try_fix(all, options_.min_fix_ambiguities);
+    epochs_since_full_set_ = 0;
+    failed_full_set_.clear();
+    if (best) out.solution.ratio = std::min(best->ratio, 999.9);
+    if (!best || !accepted(*best)) {
+      failed_full_set_ = all_keys;
+      const std::string why = !best                                    ? "integer search failed"
+                              : best->ratio < options_.ratio_threshold ? "ratio test failed"
+                                                                       : "success rate too low";
+      best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
+      if (!best) {
+        out.note = why;
+        return false;
+      }
+      out.solution.ratio = std::min(best->ratio, 999.9);
+    }
   }
   // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix).
   const Eigen::LLT<Eigen::MatrixXd> llt(best->Q_a);
@@ -874,10 +891,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
     out.note = "float ambiguity covariance not positive definite";
     return false;
   }
-  const Eigen::VectorXd x_fix = x_ - best->PDt * llt.solve(best->a_float - best->a_fix);
-  const Eigen::MatrixXd P_fix = P_ - best->PDt * llt.solve(best->PDt.transpose());
-  out.solution.p_E_m = x_fix.head<3>();
-  out.solution.P_E_m2 = P_fix.topLeftCorner<3, 3>();
+  // Only the position block is output: its rows of P D^T suffice (the whole x_fix, P_fix would cost n^2 nd).
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = best->PDt.topRows<3>();
+  out.solution.p_E_m = x_.head<3>() - PDt_p * llt.solve(best->a_float - best->a_fix);
+  out.solution.P_E_m2 = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
   out.solution.status = core::SolutionStatus::Fixed;
   out.num_fixed_ambiguities = static_cast<int>(best->a_fix.size());
   last_fix_.clear();

@@ -35,6 +35,9 @@ class TextReader {
   /// Whether the last line consumed (returned and not pushed back) is the unterminated tail that a read error left
   /// behind: a line cut short, e.g. by a truncated gzip stream.
   [[nodiscard]] bool line_cut() const { return line_cut_ && !pushed_back_; }
+  /// Fraction of the file read so far, 0..1 (of the compressed size for gzip); 0 if the size is unknown. For
+  /// progress reports: it moves in steps of the read buffer.
+  [[nodiscard]] double fraction_read() const;
   /// Error at the current line.
   [[nodiscard]] Error error(std::string message) const { return Error{std::move(message), path_, line_number_}; }
 
@@ -53,6 +56,7 @@ class TextReader {
   bool ended_ = false;
   bool line_cut_ = false;
   int line_number_ = 0;
+  std::uint64_t file_size_ = 0;  // bytes on disk, 0 if unknown
   std::optional<std::string> read_error_;
 };
 

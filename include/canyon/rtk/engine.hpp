@@ -220,6 +220,9 @@ class RtkEngine {
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;
   std::map<DdKey, double> last_fix_;  // integers of the last accepted fix; pairs leave with their ambiguities
+  static constexpr int kFullSetRetryEpochs = 10;
+  std::vector<DdKey> failed_full_set_;  // the full DD set whose integer search last failed (empty: none)
+  int epochs_since_full_set_ = 0;       // epochs since the full set was last searched
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);
