@@ -336,8 +336,8 @@ std::string RtkOptions::validate() const {
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
   if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";
-  if (!(max_post_fit_sigmas > 0.0) || max_post_fit_rejections < 0) {
-    return "max_post_fit_sigmas must be > 0 and max_post_fit_rejections >= 0";
+  if (!(max_post_fit_sigmas > 0.0) || !(max_post_fit_code_sigmas > 0.0) || max_post_fit_rejections < 0) {
+    return "max_post_fit_sigmas and max_post_fit_code_sigmas must be > 0 and max_post_fit_rejections >= 0";
   }
   if (const std::string e = slips.validate(); !e.empty()) return "slips: " + e;
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
@@ -515,23 +515,26 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
 }
 
 int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected) {
-  // Update, then check the post-fit phase residuals: a signal whose residual is beyond the threshold (a phase
-  // inconsistent with the others, e.g. an undetected slip or signals two receivers track differently) is dropped for
-  // this epoch and the update redone from the prior.
+  // Update, then check the post-fit residuals: a signal whose residual is beyond the threshold (a phase inconsistent
+  // with the others, e.g. an undetected slip or signals two receivers track differently; a code far off, e.g. a
+  // reflection) is dropped for this epoch and the update redone from the prior.
   const Eigen::VectorXd x0 = x_;
   const Eigen::MatrixXd P0 = P_;
   int used = 0;
   for (int attempt = 0; attempt <= options_.max_post_fit_rejections; ++attempt) {
     PostFit post_fit;
     used = update_once(sds, rejected, post_fit);
-    if (post_fit.worst_sd < 0 || post_fit.worst_normalised <= options_.max_post_fit_sigmas ||
-        attempt == options_.max_post_fit_rejections) {
+    if (post_fit.worst_sd < 0 || post_fit.worst_normalised <= 1.0 || attempt == options_.max_post_fit_rejections) {
       break;
     }
     SingleDiff& bad = sds[static_cast<std::size_t>(post_fit.worst_sd)];
     rejected.push_back(bad.sat);
-    bad.ambiguity = -1;  // its phase is not used (nor fixed) this epoch
-    bad.fixable = false;
+    if (post_fit.worst_is_code) {
+      bad.code_m = core::kNoValue;  // its code is not used this epoch
+    } else {
+      bad.ambiguity = -1;  // its phase is not used (nor fixed) this epoch
+      bad.fixable = false;
+    }
     x_ = x0;
     P_ = P0;
   }
@@ -641,15 +644,22 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
   U << code_step.U, phase_step.U;
   V << code_step.V, phase_step.V;
   subtract_symmetric_product(P_, U, V);
-  // Post-fit DD phase residuals, normalised by their measurement sigma: the worst one is reported.
+  // Post-fit DD residuals, normalised by their measurement sigma and by the threshold of their kind (phase or code):
+  // the worst one is reported, beyond its threshold when the normalised value exceeds 1.
   post_fit = PostFit{};
-  for (const DdRow* row : phase_rows) {
-    const double normalised = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
-    if (normalised > post_fit.worst_normalised) {
-      post_fit.worst_normalised = normalised;
-      post_fit.worst_sd = row->sd;
+  const auto check = [&](const std::vector<const DdRow*>& block, double threshold_sigmas, bool code) {
+    for (const DdRow* row : block) {
+      const double sigmas = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
+      const double normalised = sigmas / threshold_sigmas;
+      if (normalised > post_fit.worst_normalised) {
+        post_fit.worst_normalised = normalised;
+        post_fit.worst_sd = row->sd;
+        post_fit.worst_is_code = code;
+      }
     }
-  }
+  };
+  check(phase_rows, options_.max_post_fit_sigmas, false);
+  check(code_rows, options_.max_post_fit_code_sigmas, true);
   return static_cast<int>(phase_rows.size());
 }
 
