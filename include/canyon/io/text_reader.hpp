@@ -21,7 +21,8 @@ class TextReader {
   ~TextReader();
 
   /// Next line without its end-of-line characters (LF or CRLF); nullopt at end of file. A read error
-  /// (e.g. a truncated gzip stream) is reported by error() after next_line() returns nullopt.
+  /// (e.g. a truncated gzip stream) is reported by error() after next_line() returns nullopt. The view is valid until
+  /// the next call.
   std::optional<std::string_view> next_line();
   /// Pushes the last line back so the next call to next_line() returns it again (one line only).
   void unread_line();
@@ -48,9 +49,10 @@ class TextReader {
 
   std::unique_ptr<Impl> impl_;
   std::string path_;
-  std::string buffer_;
-  std::size_t buffer_pos_ = 0;
-  std::string line_;
+  std::string buffer_;        // read buffer (zlib source)
+  std::string_view view_;     // the text: the mapped file, or buffer_
+  std::size_t view_pos_ = 0;  // start of the next line in view_
+  std::string_view line_;     // the last line returned (into view_)
   bool pushed_back_ = false;
   bool eof_ = false;
   bool ended_ = false;
