@@ -95,6 +95,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("max_code_innovation_m", o.max_code_innovation_m);
   map.get("max_post_fit_sigmas", o.max_post_fit_sigmas);
   map.get("max_post_fit_code_sigmas", o.max_post_fit_code_sigmas);
+  map.get("max_partial_fix_sigma_m", o.max_partial_fix_sigma_m);
   map.get("max_post_fit_rejections", o.max_post_fit_rejections);
   map.get("hold_sigma_cyc", o.hold_sigma_cyc);
   map.get("max_outage_s", o.max_outage_s);
@@ -106,10 +107,18 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
     map.fail("troposphere", "must be saastamoinen or off, not '" + tropo + "'");
   }
   o.troposphere_saastamoinen = tropo == "saastamoinen";
-  std::string iono = o.ionosphere == rtk::IonosphereModel::Estimate ? "estimate" : "off";
+  std::string iono = rtk::ionosphere_model_name(o.ionosphere);
   map.get("ionosphere", iono);
-  if (iono != "estimate" && iono != "off") map.fail("ionosphere", "must be off or estimate, not '" + iono + "'");
-  o.ionosphere = iono == "estimate" ? rtk::IonosphereModel::Estimate : rtk::IonosphereModel::Off;
+  if (iono == "estimate") {
+    o.ionosphere = rtk::IonosphereModel::Estimate;
+  } else if (iono == "off") {
+    o.ionosphere = rtk::IonosphereModel::Off;
+  } else if (iono == "auto") {
+    o.ionosphere = rtk::IonosphereModel::Auto;
+  } else {
+    map.fail("ionosphere", "must be off, estimate or auto, not '" + iono + "'");
+  }
+  map.get("iono_auto_baseline_km", o.iono_auto_baseline_km);
   map.get("iono_sigma_per_10km_m", o.iono_sigma_per_10km_m);
   map.get("iono_sigma_min_m", o.iono_sigma_min_m);
   map.get("iono_noise_m", o.iono_noise_m);
@@ -269,14 +278,15 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "max_code_innovation_m" << YAML::Value << o.max_code_innovation_m;
   out << YAML::Key << "max_post_fit_sigmas" << YAML::Value << o.max_post_fit_sigmas;
   out << YAML::Key << "max_post_fit_code_sigmas" << YAML::Value << o.max_post_fit_code_sigmas;
+  out << YAML::Key << "max_partial_fix_sigma_m" << YAML::Value << o.max_partial_fix_sigma_m;
   out << YAML::Key << "max_post_fit_rejections" << YAML::Value << o.max_post_fit_rejections;
   out << YAML::Key << "hold_sigma_cyc" << YAML::Value << o.hold_sigma_cyc;
   out << YAML::Key << "max_outage_s" << YAML::Value << o.max_outage_s;
   out << YAML::Key << "slip_gf_threshold_m" << YAML::Value << o.slips.gf_threshold_m;
   out << YAML::Key << "slip_doppler" << YAML::Value << o.slips.use_doppler;
   out << YAML::Key << "troposphere" << YAML::Value << (o.troposphere_saastamoinen ? "saastamoinen" : "off");
-  out << YAML::Key << "ionosphere" << YAML::Value
-      << (o.ionosphere == rtk::IonosphereModel::Estimate ? "estimate" : "off");
+  out << YAML::Key << "ionosphere" << YAML::Value << rtk::ionosphere_model_name(o.ionosphere);
+  out << YAML::Key << "iono_auto_baseline_km" << YAML::Value << o.iono_auto_baseline_km;
   out << YAML::Key << "iono_sigma_per_10km_m" << YAML::Value << o.iono_sigma_per_10km_m;
   out << YAML::Key << "iono_sigma_min_m" << YAML::Value << o.iono_sigma_min_m;
   out << YAML::Key << "iono_noise_m" << YAML::Value << o.iono_noise_m;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include <Eigen/Cholesky>
 
@@ -310,6 +311,15 @@ struct SingleDiff {
   bool fixable = false;
 };
 
+const char* ionosphere_model_name(IonosphereModel model) {
+  switch (model) {
+    case IonosphereModel::Off: return "off";
+    case IonosphereModel::Estimate: return "estimate";
+    case IonosphereModel::Auto: return "auto";
+  }
+  return "?";
+}
+
 const char* ar_mode_name(ArMode mode) {
   switch (mode) {
     case ArMode::Off: return "off";
@@ -331,6 +341,8 @@ std::string RtkOptions::validate() const {
   if (min_fix_ambiguities < 1) return "min_fix_ambiguities must be >= 1";
   if (!(min_success_rate >= 0.0 && min_success_rate <= 1.0)) return "min_success_rate must be in [0, 1]";
   if (!(min_partial_fraction >= 0.0 && min_partial_fraction <= 1.0)) return "min_partial_fraction must be in [0, 1]";
+  if (!(max_partial_fix_sigma_m > 0.0)) return "max_partial_fix_sigma_m must be > 0";
+  if (!(iono_auto_baseline_km >= 0.0)) return "iono_auto_baseline_km must be >= 0";
   if (max_pruned_satellites < 0) return "max_pruned_satellites must be >= 0";
   if (!(phase_sigma_m > 0.0) || !(code_phase_ratio > 0.0)) return "phase_sigma_m and code_phase_ratio must be > 0";
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
@@ -402,6 +414,23 @@ void RtkEngine::remove_ambiguity(const AmbiguityKey& key) {
   for (auto it = last_fix_.begin(); it != last_fix_.end();) {
     it = (it->first.first == key || it->first.second == key) ? last_fix_.erase(it) : std::next(it);
   }
+}
+
+void RtkEngine::choose_ionosphere_model(double baseline_m) {
+  bool estimate = options_.ionosphere == IonosphereModel::Estimate;
+  if (options_.ionosphere == IonosphereModel::Auto) {
+    // Hysteresis: on beyond the threshold, off again only below 80 % of it (no toggling around it).
+    const double on_m = options_.iono_auto_baseline_km * 1e3;
+    estimate = iono_estimated_ ? baseline_m >= 0.8 * on_m : baseline_m > on_m;
+  }
+  if (iono_estimated_ && !estimate) {
+    std::vector<AmbiguityKey> iono;
+    for (const AmbiguityKey& key : ambiguity_keys_) {
+      if (key.second == kIonoKey) iono.push_back(key);
+    }
+    for (const AmbiguityKey& key : iono) remove_ambiguity(key);
+  }
+  iono_estimated_ = estimate;
 }
 
 void RtkEngine::clear_ambiguities() {
@@ -498,7 +527,7 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     sd.fixable = !half_cycle && glonass_ok && a.lock_epochs > options_.min_lock_epochs &&
                  sd.elevation_rad >= options_.ar_elevation_mask_rad;
   }
-  if (options_.ionosphere == IonosphereModel::Estimate) {
+  if (iono_estimated_) {
     const double baseline_10km = (x_.head<3>() - p_E_base_m_).norm() / 1e4;
     const double sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m);
     for (const SingleDiff& sd : sds) {
@@ -514,19 +543,20 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
   }
 }
 
-int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected) {
+int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected,
+                                  bool& consistent) {
   // Update, then check the post-fit residuals: a signal whose residual is beyond the threshold (a phase inconsistent
   // with the others, e.g. an undetected slip or signals two receivers track differently; a code far off, e.g. a
   // reflection) is dropped for this epoch and the update redone from the prior.
   const Eigen::VectorXd x0 = x_;
   const Eigen::MatrixXd P0 = P_;
   int used = 0;
+  consistent = true;
   for (int attempt = 0; attempt <= options_.max_post_fit_rejections; ++attempt) {
     PostFit post_fit;
     used = update_once(sds, rejected, post_fit);
-    if (post_fit.worst_sd < 0 || post_fit.worst_normalised <= 1.0 || attempt == options_.max_post_fit_rejections) {
-      break;
-    }
+    consistent = post_fit.worst_sd < 0 || post_fit.worst_normalised <= 1.0;
+    if (consistent || attempt == options_.max_post_fit_rejections) break;
     SingleDiff& bad = sds[static_cast<std::size_t>(post_fit.worst_sd)];
     rejected.push_back(bad.sat);
     if (post_fit.worst_is_code) {
@@ -751,6 +781,7 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
 }
 
 bool RtkEngine::agrees_with_last_fix(const Fix& fix) const {
+  if (fix.combinations) return true;  // no DD integers to compare
   for (std::size_t k = 0; k < fix.dd.size(); ++k) {
     const auto it = last_fix_.find(dd_key(fix.dd[k]));
     if (it != last_fix_.end() && it->second != fix.a_fix[static_cast<Eigen::Index>(k)]) return false;
@@ -762,6 +793,15 @@ RtkEngine::DdKey RtkEngine::dd_key(const std::pair<int, int>& dd) const {
   const auto k = static_cast<std::size_t>(num_kinematic_states());
   return {ambiguity_keys_[static_cast<std::size_t>(dd.first) - k],
           ambiguity_keys_[static_cast<std::size_t>(dd.second) - k]};
+}
+
+std::string RtkEngine::rejection_reason(const Fix& fix) const {
+  char numbers[96];
+  std::snprintf(numbers, sizeof numbers, " (%d ambiguities, ratio %.1f, success rate %.3f)",
+                static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate);
+  if (fix.ratio < options_.ratio_threshold) return std::string("ratio test failed") + numbers;
+  if (fix.success_rate < options_.min_success_rate) return std::string("success rate too low") + numbers;
+  return std::string("contradicts the last fix") + numbers;
 }
 
 bool RtkEngine::accepted(const Fix& fix) const {
@@ -822,6 +862,45 @@ bool RtkEngine::better_fix(const Fix& l, const Fix& r) {
   return l.a_fix.size() > r.a_fix.size() || (l.a_fix.size() == r.a_fix.size() && l.ratio > r.ratio);
 }
 
+std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full, int min_size) const {
+  const auto n = full.a_float.size();
+  auto dec = decorrelate(full.Q_a);
+  if (!dec) return std::nullopt;
+  // Longest trailing run of levels whose bootstrapped success rate stays at or above the threshold.
+  double success = 1.0;
+  Eigen::Index k0 = n;
+  while (k0 > 0) {
+    const double with_next = success * bootstrap_success_rate(dec->d.segment(k0 - 1, 1));
+    if (with_next < options_.min_success_rate) break;
+    success = with_next;
+    --k0;
+  }
+  const Eigen::Index m = n - k0;
+  if (m == n || m < std::max(min_size, options_.min_fix_ambiguities)) return std::nullopt;
+  const Eigen::MatrixXd Z_S = dec->Z.rightCols(m);
+  Fix sub;
+  sub.dd = full.dd;
+  sub.combinations = true;
+  sub.a_float = Z_S.transpose() * full.a_float;
+  sub.Q_a = Z_S.transpose() * full.Q_a * Z_S;
+  sub.Q_a = 0.5 * (sub.Q_a + sub.Q_a.transpose()).eval();
+  sub.PDt = full.PDt * Z_S;
+  auto search = mlambda(sub.a_float, sub.Q_a);
+  if (!search) return std::nullopt;
+  sub.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
+  sub.squared_norm = search->squared_norms[0];
+  sub.success_rate = bootstrap_success_rate(search->conditional_variances);
+  sub.a_fix = search->candidates.col(0);
+  if (!accepted(sub)) return std::nullopt;
+  // A few precise combinations need not pin the position down: the fix counts only if they do.
+  const Eigen::LLT<Eigen::MatrixXd> llt(sub.Q_a);
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = sub.PDt.topRows<3>();
+  const Eigen::Matrix3d P_p = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
+  if (!(std::sqrt(std::max(P_p.trace(), 0.0)) <= options_.max_partial_fix_sigma_m)) return std::nullopt;
+  return sub;
+}
+
 std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
                                                      int min_size) const {
   // First prune satellites from the full set. Then leave out whole groups or constellations (signals that the two
@@ -831,6 +910,7 @@ std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDif
   // that, the subset of the last fix still tracked: in continuous mode it usually passes again (one search).
   if (auto again = last_subset_fix(dd_ambiguities(sds, Exclusion{}), min_size)) return again;
   if (full) {
+    if (auto precise = success_rate_subset_fix(*full, min_size)) return precise;
     if (auto pruned = prune(std::move(*full), min_size)) return pruned;
   }
   std::optional<Fix> best_accepted;
@@ -884,9 +964,7 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
     if (best) out.solution.ratio = std::min(best->ratio, 999.9);
     if (!best || !accepted(*best)) {
       failed_full_set_ = all_keys;
-      const std::string why = !best                                    ? "integer search failed"
-                              : best->ratio < options_.ratio_threshold ? "ratio test failed"
-                                                                       : "success rate too low";
+      const std::string why = !best ? std::string("integer search failed") : rejection_reason(*best);
       best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
       if (!best) {
         out.note = why;
@@ -907,9 +985,12 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   out.solution.P_E_m2 = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
   out.solution.status = core::SolutionStatus::Fixed;
   out.num_fixed_ambiguities = static_cast<int>(best->a_fix.size());
+  // The integers of the DD ambiguities, for the next fixes to agree with (combinations fix no DD ambiguity as such).
   last_fix_.clear();
-  for (std::size_t k = 0; k < best->dd.size(); ++k)
-    last_fix_[dd_key(best->dd[k])] = best->a_fix[static_cast<Eigen::Index>(k)];
+  if (!best->combinations) {
+    for (std::size_t k = 0; k < best->dd.size(); ++k)
+      last_fix_[dd_key(best->dd[k])] = best->a_fix[static_cast<Eigen::Index>(k)];
+  }
   if (options_.ar_mode == ArMode::FixAndHold) {
     // Hold: the fixed DD ambiguities as pseudo-measurements with a small variance, into the float filter.
     const double var = options_.hold_sigma_cyc * options_.hold_sigma_cyc;
@@ -952,13 +1033,15 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   }
 
   if (options_.ar_mode == ArMode::Instantaneous) clear_ambiguities();
+  choose_ionosphere_model((spp->p_E_m - p_E_base_m_).norm());
   time_update(rover.time, *spp);
   const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
   const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
   detect_slips(rover_obs, base_obs);
   std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs, rover_states);
   update_ambiguities(sds, rover.time);
-  out.num_dd_measurements = measurement_update(sds, out.rejected);
+  bool consistent = true;
+  out.num_dd_measurements = measurement_update(sds, out.rejected, consistent);
   if (out.num_dd_measurements == 0) {
     out.note = "no double-differenced phase";
     return out;
@@ -971,6 +1054,14 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
     if (sds[i].frequency == 0 || (i > 0 && sds[i - 1].sat != sds[i].sat)) ++satellites;
   }
   sol.num_satellites = satellites;
+  if (!consistent) {
+    // Float validation: residuals still beyond their thresholds after the rejections allowed (more outliers than
+    // the epoch can shed, e.g. reflections in a street canyon): the float solution and its covariance cannot be
+    // trusted, and neither can integers fixed from them.
+    out.note = "float solution failed validation (post-fit residuals beyond their thresholds after " +
+               std::to_string(options_.max_post_fit_rejections) + " rejections)";
+    return out;
+  }
   if (options_.ar_mode != ArMode::Off) resolve_ambiguities(sds, out);
   return out;
 }
@@ -1004,7 +1095,7 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
     sd.frequency = r.frequency;
     sd.group = static_cast<int>(r.sat.system) * kMaxFrequencies + r.frequency;
     sd.wavelength_m = r.wavelength_m;
-    if (options_.ionosphere == IonosphereModel::Estimate) {
+    if (iono_estimated_) {
       sd.iono_scale = std::pow(r.wavelength_m / first_wavelength_m(eph_, r.sat), 2);
     }
     sd.lli = static_cast<std::uint8_t>(r.lli | b->lli);

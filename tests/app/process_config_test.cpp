@@ -110,6 +110,7 @@ TEST(ProcessConfigTest, RejectsBadConfigsNamingKeyAndLine) {
       {"spp:\n  exclude: [G99]\n", "'spp.exclude' has 'G99'", 2},
       {"spp: 5\n", "'spp' must be a map", 1},
       {"- a\n- b\n", "top level must be a map", 1},
+      {"rtk:\n  ionosphere: sometimes\n", "'rtk.ionosphere' must be off, estimate or auto", 2},
   };
   for (const auto& c : cases) {
     auto config = parse(c.yaml);
@@ -128,6 +129,24 @@ TEST(ProcessConfigTest, RejectsInvalidValues) {
   auto none = parse("spp:\n  systems: []\n");
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.error().message.find("at least one system"), std::string::npos);
+}
+
+TEST(ProcessConfigTest, IonosphereIsAutoByDefaultAndEachModeParses) {
+  auto defaults = parse("mode: rtk\n");
+  ASSERT_TRUE(defaults.ok()) << defaults.error().to_string();
+  EXPECT_EQ(defaults->rtk.ionosphere, rtk::IonosphereModel::Auto);
+  EXPECT_EQ(defaults->rtk.iono_auto_baseline_km, 10.0);
+  for (const auto& [text, model] :
+       {std::pair{"off", rtk::IonosphereModel::Off}, std::pair{"estimate", rtk::IonosphereModel::Estimate},
+        std::pair{"auto", rtk::IonosphereModel::Auto}}) {
+    auto config = parse(std::string("mode: rtk\nrtk:\n  ionosphere: ") + text + "\n  iono_auto_baseline_km: 5\n");
+    ASSERT_TRUE(config.ok()) << text;
+    EXPECT_EQ(config->rtk.ionosphere, model);
+    EXPECT_EQ(config->rtk.iono_auto_baseline_km, 5.0);
+  }
+  auto negative = parse("mode: rtk\nrtk:\n  iono_auto_baseline_km: -1\n");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_NE(negative.error().message.find("iono_auto_baseline_km"), std::string::npos);
 }
 
 TEST(ProcessConfigTest, YamlSyntaxErrorNamesTheLine) {

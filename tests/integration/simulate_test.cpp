@@ -98,19 +98,42 @@ TEST(SimulateCli, RtklibFailsInTheUrbanCanyon) {
   EXPECT_GT(stats.overall.max_3d_m, kMinUrbanMaxErrorM);
 }
 
-TEST(SimulateCli, CanyonRtkWithIonosphereEstimationFixesOpenSky) {
+/// canyon process with the shipped config/rtk.yaml (ionosphere: auto, estimated at the scenario's 20 km) on `dir`.
+fs::path run_canyon_rtk(const fs::path& dir) {
+  fs::path pos = dir / "canyon.pos";
+  const auto r = canyon("process -q --config " + std::string(CANYON_SOURCE_DIR) + "/config/rtk.yaml --rover " +
+                        (dir / "rover.obs").string() + " --base " + (dir / "base.obs").string() + " --nav " +
+                        (dir / "nav.rnx").string() + " --out " + pos.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return pos;
+}
+
+TEST(SimulateCli, CanyonRtkWithTheShippedDefaultsFixesOpenSkyAsRtklibDoes) {
   const fs::path dir = generate("open-sky", "canyon-open-sky");
-  const fs::path config = dir / "rtk-iono.yaml";
-  std::ofstream(config) << "mode: rtk\nrtk:\n  ionosphere: estimate\n";
-  const fs::path pos = dir / "canyon.pos";
-  const auto r =
-      canyon("process -q --config " + config.string() + " --rover " + (dir / "rover.obs").string() + " --base " +
-             (dir / "base.obs").string() + " --nav " + (dir / "nav.rnx").string() + " --out " + pos.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const eval::SolutionStats stats = score(pos, dir);
-  EXPECT_GE(stats.fixed().fraction_of_epochs_in, kMinOpenSkyFixFraction);
-  EXPECT_LE(stats.fixed().error.rmse_3d_m, kMaxOpenSkyFixedRmseM);
-  EXPECT_EQ(stats.wrong_fixes, 0);
+  const eval::SolutionStats ours = score(run_canyon_rtk(dir), dir);
+  const eval::SolutionStats theirs = score(run_rtklib(dir), dir);
+  EXPECT_GE(ours.fixed().fraction_of_epochs_in, kMinOpenSkyFixFraction);
+  // RTKLIB may take the very first epochs on the ratio test alone where canyon also wants the bootstrapped success
+  // rate (0.19 at the first epoch here): up to 1 % of the epochs (the 10-minute figures, 3 seeds, are in the README:
+  // canyon's fix rate is RTKLIB's or higher there).
+  EXPECT_GE(ours.fixed().epochs, theirs.fixed().epochs - 9);
+  EXPECT_LE(ours.fixed().error.rmse_3d_m, kMaxOpenSkyFixedRmseM);
+  EXPECT_LE(ours.fixed().error.rmse_3d_m, theirs.fixed().error.rmse_3d_m);
+  EXPECT_EQ(ours.wrong_fixes, 0);
+  ASSERT_TRUE(ours.time_to_first_fix_s.has_value());
+  EXPECT_LE(*ours.time_to_first_fix_s, 2.0);  // partial fixing by the success rate while the float converges
+}
+
+TEST(SimulateCli, CanyonRtkNeverFixesWronglyInStreetCanyonsAndStaysCloserThanRtklib) {
+  // Float validation keeps fixes away from floats that reflections have corrupted (RTKLIB's fixes there are wrong).
+  for (const char* scenario : {"urban-moderate", "urban-severe"}) {
+    const fs::path dir = generate(scenario, std::string("canyon-") + scenario);
+    const eval::SolutionStats ours = score(run_canyon_rtk(dir), dir);
+    const eval::SolutionStats theirs = score(run_rtklib(dir), dir);
+    EXPECT_EQ(ours.wrong_fixes, 0) << scenario;
+    EXPECT_LE(ours.overall.rmse_3d_m, theirs.overall.rmse_3d_m) << scenario;
+    EXPECT_GE(ours.fixed().epochs - ours.wrong_fixes, theirs.fixed().epochs - theirs.wrong_fixes) << scenario;
+  }
 }
 
 }  // namespace

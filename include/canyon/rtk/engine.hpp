@@ -25,6 +25,8 @@
 // max_post_fit_code_sigmas for code, in measurement sigmas) by the largest factor is dropped for the epoch and the
 // update redone from the prior (at most max_post_fit_rejections times). A code outlier (an NLOS signal, a code of
 // another tracking mode) pulls the float position and with it every ambiguity; rejecting it keeps the float fixable.
+// Float validation: when residuals are still beyond their thresholds after the rejections allowed, the epoch keeps
+// its float solution and no fix is attempted.
 //
 // Cycle slips: each receiver's phases go through a CycleSlipDetector (loss of lock, half-cycle changes,
 // geometry-free jumps, Doppler against phase, outages); a slip at either receiver re-initialises the SD ambiguity,
@@ -42,8 +44,10 @@
 // fed back as pseudo-measurements with a small variance). When the whole set is not accepted, partial fixing
 // (partial_ar): the paper's pruning, dropping the satellite whose ambiguities contribute most to the integer
 // least-squares residual, one at a time; then leaving out each (constellation, frequency) group and each
-// constellation; a subset keeps at least min_partial_fraction of the ambiguities. GLONASS ambiguities are fixed only
-// when glonass_ar is on.
+// constellation; a subset keeps at least min_partial_fraction of the ambiguities. Before pruning, partial fixing by
+// the success rate: the most precise integer combinations of the full set (in its decorrelated space) whose
+// bootstrapped success rate reaches min_success_rate, when they pass the ratio test: while a float solution
+// converges, part of it is already determined. GLONASS ambiguities are fixed only when glonass_ar is on.
 
 #include <map>
 #include <optional>
@@ -68,9 +72,10 @@ struct SingleDiff;  // one (satellite, frequency) rover-base single difference (
 
 enum class ArMode { Off, Continuous, Instantaneous, FixAndHold };
 
-/// Differential ionosphere: neglected (short baselines) or estimated as one single-differenced slant delay per
-/// satellite (L1-band metres, scaled by (f_1 / f)^2 on other frequencies; it delays code and advances phase).
-enum class IonosphereModel { Off, Estimate };
+/// Differential ionosphere: neglected (short baselines), estimated as one single-differenced slant delay per
+/// satellite (L1-band metres, scaled by (f_1 / f)^2 on other frequencies; it delays code and advances phase), or
+/// Auto: estimated while the baseline is longer than iono_auto_baseline_km (off again below 80 % of it).
+enum class IonosphereModel { Off, Estimate, Auto };
 
 struct RtkOptions {
   ObservableOptions observables;  ///< systems, number of frequencies (1..3), excluded satellites
@@ -92,6 +97,8 @@ struct RtkOptions {
   int max_pruned_satellites = 6;              ///< partial fixing drops at most this many satellites one by one
   double min_success_rate = 0.99;             ///< bootstrapped success rate a fix needs besides the ratio test
   double min_partial_fraction = 0.2;          ///< a partial fix keeps at least this fraction of the ambiguities
+  double max_partial_fix_sigma_m = 0.1;       ///< a partial fix by the success rate must leave the position this
+                                              ///< precise (3D sigma, m) to count as fixed
   int min_lock_epochs = 0;                    ///< epochs an ambiguity must be tracked before it is fixed
   bool glonass_ar = false;                    ///< fix GLONASS ambiguities (needs equal inter-frequency biases)
   double max_age_s = 30.0;                    ///< base observations older than this are not used
@@ -104,7 +111,8 @@ struct RtkOptions {
   double max_outage_s = 5.0;                  ///< an ambiguity not observed for longer is re-initialised
   CycleSlipOptions slips;                     ///< cycle-slip detection at each receiver
   bool troposphere_saastamoinen = true;       ///< model the troposphere at each receiver (off: data without one)
-  IonosphereModel ionosphere = IonosphereModel::Off;  ///< differential ionosphere model
+  IonosphereModel ionosphere = IonosphereModel::Auto;  ///< differential ionosphere model
+  double iono_auto_baseline_km = 10.0;  ///< with Auto, the ionosphere is estimated on baselines longer than this
   double iono_sigma_per_10km_m = 0.03;  ///< prior sigma of a SD ionosphere state per 10 km of baseline (m)
   double iono_sigma_min_m = 0.001;      ///< the prior sigma is at least this (m), whatever the baseline
   double iono_noise_m = 0.001;          ///< SD ionosphere random walk (m per sqrt(s))
@@ -159,7 +167,8 @@ class RtkEngine {
   /// Appends the states in order, with one resize of x and P for all of them.
   void add_states(const std::vector<NewState>& states);
   /// EKF update with the DD code and phase, with post-fit rejection; returns the number of DD phase rows used.
-  int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
+  /// `consistent`: no post-fit residual is left beyond its threshold (the float solution passes validation).
+  int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected, bool& consistent);
   struct PostFit {
     int worst_sd = -1;              // SD of the largest normalised post-fit residual
     double worst_normalised = 0.0;  // |residual| / (measurement sigma * threshold of its kind): beyond when > 1
@@ -176,11 +185,23 @@ class RtkEngine {
     double ratio = 0.0;
     double squared_norm = 0.0;  // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
     double success_rate = 0.0;  // bootstrapped success rate of the float model
+    // The fixed quantities are integer combinations Z_S^T of the DD ambiguities dd (a_float = Z_S^T D x, PDt = P D^T
+    // Z_S) rather than the DD ambiguities themselves: a partial fix by the success rate.
+    bool combinations = false;
   };
   /// MLAMBDA on a set of DD ambiguities; nullopt if the set has fewer than max(min_size, min_fix_ambiguities).
   [[nodiscard]] std::optional<Fix> try_fix(const std::vector<std::pair<int, int>>& dd, int min_size) const;
+  /// Partial fixing by the success rate (Teunissen's partial ambiguity resolution): in the decorrelated space
+  /// z = Z^T a of the full set, Q_z = L^T D L, the trailing levels k0..n-1 form a problem of their own (their
+  /// factors are the trailing blocks of L and D) whose bootstrapped success rate is prod_{k >= k0} p_k. Fixes the
+  /// largest such trailing set whose success rate reaches min_success_rate, if it has at least
+  /// max(min_size, min_fix_ambiguities) members, passes the ratio test and leaves a position whose 3D sigma is
+  /// within max_partial_fix_sigma_m. nullopt otherwise.
+  [[nodiscard]] std::optional<Fix> success_rate_subset_fix(const Fix& full, int min_size) const;
   /// Ratio test, success rate and agreement with the last fix.
   [[nodiscard]] bool accepted(const Fix& fix) const;
+  /// Why a fix is not accepted, with its figures (for --verbose).
+  [[nodiscard]] std::string rejection_reason(const Fix& fix) const;
   /// A DD ambiguity by the keys of its two SD ambiguities (satellite s, reference satellite).
   using DdKey = std::pair<AmbiguityKey, AmbiguityKey>;
   [[nodiscard]] DdKey dd_key(const std::pair<int, int>& dd) const;
@@ -203,6 +224,9 @@ class RtkEngine {
   /// MLAMBDA and the ratio test, then partial fixing without one group if the whole set fails; fills the fixed
   /// solution of `out` and returns true when fixed.
   bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
+  /// Whether the ionosphere is estimated at this epoch (Off, Estimate, or Auto by the baseline); turning it off
+  /// removes the ionosphere states.
+  void choose_ionosphere_model(double baseline_m);
   void add_ambiguity(const AmbiguityKey& key, double value, double variance);
   void remove_ambiguity(const AmbiguityKey& key);
   /// Removes every keyed state (ambiguities, ionosphere) at once: instantaneous mode, each epoch.
@@ -227,8 +251,11 @@ class RtkEngine {
   static constexpr int kFullSetRetryEpochs = 10;
   std::vector<DdKey> failed_full_set_;  // the full DD set whose integer search last failed (empty: none)
   int epochs_since_full_set_ = 0;       // epochs since the full set was last searched
+  bool iono_estimated_ = false;         // ionosphere states in use at this epoch
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);
+/// "off", "estimate" or "auto", as in the configuration.
+[[nodiscard]] const char* ionosphere_model_name(IonosphereModel model);
 
 }  // namespace canyon::rtk
