@@ -96,6 +96,8 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("max_post_fit_sigmas", o.max_post_fit_sigmas);
   map.get("max_post_fit_code_sigmas", o.max_post_fit_code_sigmas);
   map.get("max_partial_fix_sigma_m", o.max_partial_fix_sigma_m);
+  map.get("snr_weighting", o.snr_weighting);
+  map.get("snr_reference_dbhz", o.snr_reference_dbhz);
   map.get("max_post_fit_rejections", o.max_post_fit_rejections);
   map.get("hold_sigma_cyc", o.hold_sigma_cyc);
   map.get("max_outage_s", o.max_outage_s);
@@ -279,6 +281,8 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "max_post_fit_sigmas" << YAML::Value << o.max_post_fit_sigmas;
   out << YAML::Key << "max_post_fit_code_sigmas" << YAML::Value << o.max_post_fit_code_sigmas;
   out << YAML::Key << "max_partial_fix_sigma_m" << YAML::Value << o.max_partial_fix_sigma_m;
+  out << YAML::Key << "snr_weighting" << YAML::Value << o.snr_weighting;
+  out << YAML::Key << "snr_reference_dbhz" << YAML::Value << o.snr_reference_dbhz;
   out << YAML::Key << "max_post_fit_rejections" << YAML::Value << o.max_post_fit_rejections;
   out << YAML::Key << "hold_sigma_cyc" << YAML::Value << o.hold_sigma_cyc;
   out << YAML::Key << "max_outage_s" << YAML::Value << o.max_outage_s;

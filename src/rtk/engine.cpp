@@ -71,9 +71,16 @@ double any_pseudorange(const ReceiverObservables& obs, SatelliteId sat) {
   return core::kNoValue;
 }
 
-double zero_diff_phase_variance(const RtkOptions& o, double elevation_rad) {
+/// Zero-difference carrier-phase variance (m^2) of a signal at `elevation_rad` with C/N0 `snr_dbhz` (NaN: unknown):
+/// a^2 + b^2 / sin^2(el), the second term scaled by 10^((snr_reference - snr) / 10) below the reference C/N0 when
+/// SNR weighting is on (noise power grows as C/N0 falls; reflected signals arrive weaker).
+double zero_diff_phase_variance(const RtkOptions& o, double elevation_rad, double snr_dbhz) {
+  const double b2 = o.phase_sigma_el_m * o.phase_sigma_el_m;
+  if (o.snr_weighting && core::has_value(snr_dbhz) && snr_dbhz > 0.0) {
+    return o.phase_sigma_m * o.phase_sigma_m + b2 * std::pow(10.0, (o.snr_reference_dbhz - snr_dbhz) / 10.0);
+  }
   const double sin_el = std::max(std::sin(elevation_rad), 0.05);
-  return o.phase_sigma_m * o.phase_sigma_m + o.phase_sigma_el_m * o.phase_sigma_el_m / (sin_el * sin_el);
+  return o.phase_sigma_m * o.phase_sigma_m + b2 / (sin_el * sin_el);
 }
 
 /// A linear(ised) DD measurement row, sparse: h = h_pos . p + sum of entries (state index, coefficient); innovation v,
@@ -301,6 +308,7 @@ struct SingleDiff {
   double code_m = core::kNoValue;   // (P_r - P_b) - (model_r - model_b)
   double phase_variance_m2 = 0.0;
   double code_variance_m2 = 0.0;
+  double test_variance_m2 = 0.0;  // phase variance of the elevation model alone, for the post-fit tests
   Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  // rover line of sight
   double elevation_rad = 0.0;
   std::uint8_t lli = 0;     // rover | base loss-of-lock bits
@@ -342,6 +350,7 @@ std::string RtkOptions::validate() const {
   if (!(min_success_rate >= 0.0 && min_success_rate <= 1.0)) return "min_success_rate must be in [0, 1]";
   if (!(min_partial_fraction >= 0.0 && min_partial_fraction <= 1.0)) return "min_partial_fraction must be in [0, 1]";
   if (!(max_partial_fix_sigma_m > 0.0)) return "max_partial_fix_sigma_m must be > 0";
+  if (!(snr_reference_dbhz > 0.0)) return "snr_reference_dbhz must be > 0";
   if (!(iono_auto_baseline_km >= 0.0)) return "iono_auto_baseline_km must be >= 0";
   if (max_pruned_satellites < 0) return "max_pruned_satellites must be >= 0";
   if (!(phase_sigma_m > 0.0) || !(code_phase_ratio > 0.0)) return "phase_sigma_m and code_phase_ratio must be > 0";
@@ -637,6 +646,14 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
     if (&ra == &rb) return sd_variance(ra, ra.sd) + sd_variance(ra, ra.reference);
     return rb.phase == ra.phase && rb.reference == ra.reference ? sd_variance(ra, ra.reference) : 0.0;
   };
+  // The post-fit tests measure residuals against the elevation model alone: SNR weighting lowers the weight of weak
+  // signals in the estimate, not the scrutiny they get (a reflection must still stand out as an outlier).
+  const auto test_variance = [&](const DdRow& row) {
+    const SingleDiff& s = sds[static_cast<std::size_t>(row.sd)];
+    const SingleDiff& r = sds[static_cast<std::size_t>(row.reference)];
+    const double ratio2 = row.phase ? 1.0 : options_.code_phase_ratio * options_.code_phase_ratio;
+    return (s.test_variance_m2 + r.test_variance_m2) * ratio2;
+  };
   // R being block diagonal, the update is two sequential ones, the same as the joint update in exact arithmetic:
   // the code rows, which touch only the position (and ionosphere states), in compressed form, then the phase rows at
   // the code-updated covariance. Neither is applied before both factorisations have succeeded.
@@ -679,7 +696,7 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
   post_fit = PostFit{};
   const auto check = [&](const std::vector<const DdRow*>& block, double threshold_sigmas, bool code) {
     for (const DdRow* row : block) {
-      const double sigmas = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
+      const double sigmas = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(test_variance(*row));
       const double normalised = sigmas / threshold_sigmas;
       if (normalised > post_fit.worst_normalised) {
         post_fit.worst_normalised = normalised;
@@ -892,17 +909,18 @@ std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full
   sub.success_rate = bootstrap_success_rate(search->conditional_variances);
   sub.a_fix = search->candidates.col(0);
   if (!accepted(sub)) return std::nullopt;
-  // A few precise combinations need not pin the position down: the fix counts only if they do.
+  // A few precise combinations need not pin the position down: the fix counts only if they do (otherwise the caller
+  // may still use them to sharpen the float position).
   const Eigen::LLT<Eigen::MatrixXd> llt(sub.Q_a);
   if (llt.info() != Eigen::Success) return std::nullopt;
   const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = sub.PDt.topRows<3>();
   const Eigen::Matrix3d P_p = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
-  if (!(std::sqrt(std::max(P_p.trace(), 0.0)) <= options_.max_partial_fix_sigma_m)) return std::nullopt;
+  sub.imprecise = !(std::sqrt(std::max(P_p.trace(), 0.0)) <= options_.max_partial_fix_sigma_m);
   return sub;
 }
 
 std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
-                                                     int min_size) const {
+                                                     int min_size, std::optional<Fix>& imprecise) const {
   // First prune satellites from the full set. Then leave out whole groups or constellations (signals that the two
   // receivers track differently bias a whole group): the accepted subset with the most ambiguities, or else the
   // best of pruning the kPrunedSubsets subsets closest to passing (highest ratio). At most
@@ -910,7 +928,10 @@ std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDif
   // that, the subset of the last fix still tracked: in continuous mode it usually passes again (one search).
   if (auto again = last_subset_fix(dd_ambiguities(sds, Exclusion{}), min_size)) return again;
   if (full) {
-    if (auto precise = success_rate_subset_fix(*full, min_size)) return precise;
+    if (auto combinations = success_rate_subset_fix(*full, min_size)) {
+      if (!combinations->imprecise) return combinations;
+      imprecise = std::move(combinations);
+    }
     if (auto pruned = prune(std::move(*full), min_size)) return pruned;
   }
   std::optional<Fix> best_accepted;
@@ -965,9 +986,20 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
     if (!best || !accepted(*best)) {
       failed_full_set_ = all_keys;
       const std::string why = !best ? std::string("integer search failed") : rejection_reason(*best);
-      best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
+      std::optional<Fix> imprecise;
+      best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size, imprecise) : std::nullopt;
       if (!best) {
         out.note = why;
+        if (imprecise) {
+          // The most precise combinations are fixed, but not enough of them to call the position fixed: the float
+          // position conditioned on them is still the better one.
+          const Eigen::LLT<Eigen::MatrixXd> llt(imprecise->Q_a);
+          const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = imprecise->PDt.topRows<3>();
+          out.solution.p_E_m = x_.head<3>() - PDt_p * llt.solve(imprecise->a_float - imprecise->a_fix);
+          out.solution.P_E_m2 = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
+          out.note += "; float position conditioned on " + std::to_string(imprecise->a_fix.size()) +
+                      " fixed integer combinations";
+        }
         return false;
       }
       out.solution.ratio = std::min(best->ratio, 999.9);
@@ -1107,9 +1139,12 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
     if (core::has_value(r.pseudorange_m) && core::has_value(b->pseudorange_m)) {
       sd.code_m = (r.pseudorange_m - b->pseudorange_m) - model_m;
     }
-    const double var_zd = zero_diff_phase_variance(options_, zr.elevation_rad);
-    sd.phase_variance_m2 = 2.0 * var_zd;
-    sd.code_variance_m2 = 2.0 * var_zd * options_.code_phase_ratio * options_.code_phase_ratio;
+    const double var_sd = zero_diff_phase_variance(options_, zr.elevation_rad, r.snr_dbhz) +
+                          zero_diff_phase_variance(options_, zb.elevation_rad, b->snr_dbhz);
+    sd.phase_variance_m2 = var_sd;
+    sd.code_variance_m2 = var_sd * options_.code_phase_ratio * options_.code_phase_ratio;
+    sd.test_variance_m2 = zero_diff_phase_variance(options_, zr.elevation_rad, core::kNoValue) +
+                          zero_diff_phase_variance(options_, zb.elevation_rad, core::kNoValue);
     sd.los_E = zr.los_E;
     sd.elevation_rad = zr.elevation_rad;
     sds.push_back(sd);

@@ -3,8 +3,8 @@
 # into a temp folder, run
 #   RTKLIB  rnx2rtkp -k config/rtklib/sim.conf (kinematic, forward, continuous AR, ratio 3, L1+L2, 15 deg mask,
 #           base position from the base header, ionosphere est-stec) and the same with pos1-ionoopt=brdc;
-#   canyon  canyon process --mode rtk --config config/rtk.yaml (the defaults: ionosphere: auto, estimated on
-#           baselines beyond 10 km, so here) and the same with ionosphere: off;
+#   canyon  canyon process --mode rtk --config config/rtk-urban.yaml (SNR weighting; ionosphere: auto, estimated
+#           on baselines beyond 10 km, so here) and with config/rtk.yaml (the defaults: elevation weighting);
 # and score every .pos against the scenario's truth.csv with bench_eval_pos (canyon::eval): fix rate (fixed epochs /
 # rover epochs), 3D RMSE and maximum 3D error over all solved epochs, wrong fixes (fixed, 3D error > 0.10 m).
 #
@@ -35,8 +35,6 @@ else
   trap 'rm -rf "$tmp"' EXIT
 fi
 sed 's/^pos1-ionoopt .*/pos1-ionoopt       =brdc/' "$conf" >"$tmp/rtklib-brdc.conf"
-sed 's/^\( *ionosphere:\) auto /\1 off  /' "$root/config/rtk.yaml" >"$tmp/rtk-iono-off.yaml"
-grep -q "ionosphere: off" "$tmp/rtk-iono-off.yaml" || { echo "error: could not switch ionosphere in rtk.yaml" >&2; exit 2; }
 
 # Value of key $2 in a bench_eval_pos --kv line $1, "-" if absent.
 kv() { tr ' ' '\n' <<<"$1" | awk -F= -v k="$2" '$1 == k {print $2; found = 1} END {if (!found) print "-"}'; }
@@ -49,7 +47,7 @@ score() {
 }
 
 printf '%-15s %4s %6s %6s | %-28s | %-28s | %-28s | %-28s\n' scenario seed gen_s nlos% \
-  "RTKLIB est-stec fix/rmse/max" "RTKLIB brdc fix/rmse/max" "canyon (default) fix/rmse/max" "canyon iono off fix/rmse/max"
+  "RTKLIB est-stec fix/rmse/max" "RTKLIB brdc fix/rmse/max" "canyon rtk-urban fix/rmse/max" "canyon rtk.yaml fix/rmse/max"
 for scenario in "${scenarios[@]}"; do
   for seed in $seeds; do
     dir=$tmp/$scenario-$seed
@@ -60,12 +58,12 @@ for scenario in "${scenarios[@]}"; do
     rnx2rtkp -k "$conf" -o "$dir/rtklib.pos" "$dir/rover.obs" "$dir/base.obs" "$dir/nav.rnx" >/dev/null 2>&1
     rnx2rtkp -k "$tmp/rtklib-brdc.conf" -o "$dir/rtklib-brdc.pos" "$dir/rover.obs" "$dir/base.obs" "$dir/nav.rnx" \
       >/dev/null 2>&1
-    "$canyon" process -q --mode rtk --config "$root/config/rtk.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
+    "$canyon" process -q --mode rtk --config "$root/config/rtk-urban.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
       --nav "$dir/nav.rnx" --out "$dir/canyon.pos" >/dev/null 2>&1 || true
-    "$canyon" process -q --mode rtk --config "$tmp/rtk-iono-off.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
-      --nav "$dir/nav.rnx" --out "$dir/canyon-iono-off.pos" >/dev/null 2>&1 || true
+    "$canyon" process -q --mode rtk --config "$root/config/rtk.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
+      --nav "$dir/nav.rnx" --out "$dir/canyon-default.pos" >/dev/null 2>&1 || true
     cells=()
-    for pos in rtklib rtklib-brdc canyon canyon-iono-off; do
+    for pos in rtklib rtklib-brdc canyon canyon-default; do
       if [[ -s $dir/$pos.pos ]]; then
         read -r fix rmse max wrong <<<"$(score "$dir/$pos.pos" "$dir")"
         cells+=("$(printf '%5s%% %8s m %8s m w%s' "$fix" "$rmse" "$max" "$wrong")")

@@ -98,10 +98,11 @@ TEST(SimulateCli, RtklibFailsInTheUrbanCanyon) {
   EXPECT_GT(stats.overall.max_3d_m, kMinUrbanMaxErrorM);
 }
 
-/// canyon process with the shipped config/rtk.yaml (ionosphere: auto, estimated at the scenario's 20 km) on `dir`.
+/// canyon process with the shipped config/rtk-urban.yaml (SNR weighting; the ionosphere estimated at the scenario's
+/// 20 km by rtk.yaml's ionosphere: auto) on `dir`.
 fs::path run_canyon_rtk(const fs::path& dir) {
   fs::path pos = dir / "canyon.pos";
-  const auto r = canyon("process -q --config " + std::string(CANYON_SOURCE_DIR) + "/config/rtk.yaml --rover " +
+  const auto r = canyon("process -q --config " + std::string(CANYON_SOURCE_DIR) + "/config/rtk-urban.yaml --rover " +
                         (dir / "rover.obs").string() + " --base " + (dir / "base.obs").string() + " --nav " +
                         (dir / "nav.rnx").string() + " --out " + pos.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;

@@ -26,7 +26,7 @@ struct DemoConfig {
   std::optional<std::uint64_t> seed;              ///< default: the scenario's
   std::optional<double> duration_s;               ///< default: the scenario's
   std::string out_dir = "out/demo";               ///< created if needed
-  std::string rtk_config = "rtk.yaml";            ///< canyon's RTK configuration, a file in the shipped config/
+  std::string rtk_config = "rtk-urban.yaml";      ///< canyon's RTK configuration, a file in the shipped config/
   std::string rtklib_config = "rtklib/sim.conf";  ///< RTKLIB's option file, in the shipped config/
   bool run_rtklib = true;                         ///< run `rnx2rtkp` (skipped with a note when not installed)
   std::string rtklib_program = "rnx2rtkp";        ///< found on PATH

@@ -16,8 +16,14 @@
 // whose time tags differ by milliseconds difference correctly). Receiver clocks cancel in the double differences.
 // The differential ionosphere is neglected (short baselines) or, with IonosphereModel::Estimate, enters as
 // -mu_s I_sd,s + mu_r I_sd,r on phase and with the opposite sign on code, mu = (f_1 / f)^2. Zero-difference variance
-// per receiver:
-//   sigma_phase^2 = a^2 + b^2 / sin^2(el),  sigma_code = code_phase_ratio * sigma_phase.
+// per receiver, at that receiver's elevation el and C/N0:
+//   sigma_phase^2 = a^2 + b^2 / sin^2(el)                      (elevation model, the default, as RTKLIB's)
+//   sigma_phase^2 = a^2 + b^2 10^((snr_reference - C/N0) / 10)  (snr_weighting, SIGMA-epsilon: the C/N0 already
+//                                                                holds the elevation through the antenna gain, and
+//                                                                reflected signals arrive weaker)
+//   sigma_code = code_phase_ratio * sigma_phase.
+// The post-fit outlier tests below use the elevation model either way, so that weighting down a weak signal does not
+// hide it from them.
 // The DD covariance follows from the SD variances (correlated through the reference satellite).
 //
 // Outliers: DD innovations beyond max_phase_innovation_m / max_code_innovation_m are not used; after the update,
@@ -88,6 +94,8 @@ struct RtkOptions {
   double phase_sigma_m = 0.003;               ///< a: zenith-independent phase noise (m)
   double phase_sigma_el_m = 0.003;            ///< b: elevation-dependent phase noise (m), divided by sin(el)
   double code_phase_ratio = 100.0;            ///< code sigma / phase sigma
+  bool snr_weighting = false;                 ///< b^2 10^((snr_reference - C/N0) / 10) instead of b^2 / sin^2(el)
+  double snr_reference_dbhz = 45.0;           ///< C/N0 at which the SNR model's phase sigma is b (dB-Hz)
   double initial_ambiguity_sigma_cyc = 30.0;  ///< sigma of a new ambiguity (cycles)
   double ambiguity_noise_cyc = 1e-4;          ///< ambiguity random walk (cycles per sqrt(s))
   double initial_position_sigma_m = 30.0;     ///< sigma of the SPP position used as prior (m)
@@ -188,6 +196,7 @@ class RtkEngine {
     // The fixed quantities are integer combinations Z_S^T of the DD ambiguities dd (a_float = Z_S^T D x, PDt = P D^T
     // Z_S) rather than the DD ambiguities themselves: a partial fix by the success rate.
     bool combinations = false;
+    bool imprecise = false;  // combinations that leave the position less precise than max_partial_fix_sigma_m
   };
   /// MLAMBDA on a set of DD ambiguities; nullopt if the set has fewer than max(min_size, min_fix_ambiguities).
   [[nodiscard]] std::optional<Fix> try_fix(const std::vector<std::pair<int, int>>& dd, int min_size) const;
@@ -195,8 +204,9 @@ class RtkEngine {
   /// z = Z^T a of the full set, Q_z = L^T D L, the trailing levels k0..n-1 form a problem of their own (their
   /// factors are the trailing blocks of L and D) whose bootstrapped success rate is prod_{k >= k0} p_k. Fixes the
   /// largest such trailing set whose success rate reaches min_success_rate, if it has at least
-  /// max(min_size, min_fix_ambiguities) members, passes the ratio test and leaves a position whose 3D sigma is
-  /// within max_partial_fix_sigma_m. nullopt otherwise.
+  /// max(min_size, min_fix_ambiguities) members and passes the ratio test; nullopt otherwise. Fix::imprecise is set
+  /// when the position it leaves has a 3D sigma above max_partial_fix_sigma_m (then it is no fix, but the float
+  /// position conditioned on it is still the better float).
   [[nodiscard]] std::optional<Fix> success_rate_subset_fix(const Fix& full, int min_size) const;
   /// Ratio test, success rate and agreement with the last fix.
   [[nodiscard]] bool accepted(const Fix& fix) const;
@@ -219,8 +229,10 @@ class RtkEngine {
   /// More ambiguities, then the higher ratio.
   [[nodiscard]] static bool better_fix(const Fix& l, const Fix& r);
   /// Partial fixing after the full set failed: pruning, then without each group or constellation.
+  /// `imprecise`: set to a partial fix by the success rate that passed its tests but leaves the position less precise
+  /// than max_partial_fix_sigma_m (not a fix, but a better float position).
   [[nodiscard]] std::optional<Fix> partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
-                                               int min_size) const;
+                                               int min_size, std::optional<Fix>& imprecise) const;
   /// MLAMBDA and the ratio test, then partial fixing without one group if the whole set fails; fills the fixed
   /// solution of `out` and returns true when fixed.
   bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
