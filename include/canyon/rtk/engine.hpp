@@ -105,7 +105,7 @@ struct RtkOptions {
   int max_pruned_satellites = 6;              ///< partial fixing drops at most this many satellites one by one
   double min_success_rate = 0.99;             ///< bootstrapped success rate a fix needs besides the ratio test
   double min_partial_fraction = 0.2;          ///< a partial fix keeps at least this fraction of the ambiguities
-  double max_partial_fix_sigma_m = 0.1;       ///< a partial fix by the success rate must leave the position this
+  double max_partial_fix_sigma_m = 0.05;      ///< a partial fix by the success rate must leave the position this
                                               ///< precise (3D sigma, m) to count as fixed
   int min_lock_epochs = 0;                    ///< epochs an ambiguity must be tracked before it is fixed
   bool glonass_ar = false;                    ///< fix GLONASS ambiguities (needs equal inter-frequency biases)
