@@ -11,37 +11,8 @@ namespace canyon::sim {
 namespace {
 
 constexpr std::uint64_t kVioStream = 0x710, kSyncStream = 0x5C;
-constexpr double kSmallAngleRad = 1e-9;
 constexpr double kInitialPositionVarM2 = 1e-8;
 constexpr double kInitialAngleVarRad2 = 1e-10;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
-/// Left Jacobian of SO(3), V(phi) of the SE(3) exponential.
-Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi) {
-  const double theta = phi.norm();
-  const Eigen::Matrix3d k = skew(phi);
-  if (theta < kSmallAngleRad) return Eigen::Matrix3d::Identity() + 0.5 * k;
-  const double t2 = theta * theta;
-  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * k +
-         (theta - std::sin(theta)) / (t2 * theta) * k * k;
-}
-
-Eigen::Quaterniond so3_exp(const Eigen::Vector3d& phi) {
-  const double theta = phi.norm();
-  if (theta < kSmallAngleRad) return Eigen::Quaterniond(1.0, 0.5 * phi.x(), 0.5 * phi.y(), 0.5 * phi.z()).normalized();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(theta, phi / theta));
-}
-
-Eigen::Vector3d so3_log(const Eigen::Quaterniond& q) {
-  const Eigen::AngleAxisd aa(q.normalized());
-  const double angle = aa.angle() > core::kPi ? aa.angle() - 2.0 * core::kPi : aa.angle();
-  return angle * aa.axis();
-}
 
 /// Device clock reading (ns) at `t_s` seconds after the start.
 double device_ns(const VioOptions& o, double t_s) {
@@ -70,27 +41,6 @@ Matrix6d step_noise(const VioOptions& o, double distance_m) {
 }
 
 }  // namespace
-
-Pose se3_exp(const Vector6d& xi) {
-  const Eigen::Vector3d phi = xi.tail<3>();
-  return {so3_exp(phi), so3_left_jacobian(phi) * xi.head<3>()};
-}
-
-Vector6d se3_log(const Pose& T) {
-  const Eigen::Vector3d phi = so3_log(T.q);
-  Vector6d xi;
-  xi << so3_left_jacobian(phi).inverse() * T.p, phi;
-  return xi;
-}
-
-Matrix6d se3_adjoint(const Pose& T) {
-  const Eigen::Matrix3d R = T.q.toRotationMatrix();
-  Matrix6d ad = Matrix6d::Zero();
-  ad.topLeftCorner<3, 3>() = R;
-  ad.topRightCorner<3, 3>() = skew(T.p) * R;
-  ad.bottomRightCorner<3, 3>() = R;
-  return ad;
-}
 
 Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s) {
   const Eigen::Vector2d h = trajectory.heading_N(t_s);

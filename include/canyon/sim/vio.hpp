@@ -32,29 +32,21 @@
 #include <Eigen/Geometry>
 
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/se3.hpp"
 #include "canyon/core/time.hpp"
 #include "canyon/sim/route.hpp"
 #include "canyon/sim/scenario.hpp"
 
 namespace canyon::sim {
 
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-
-/// A rigid transform (rotation and translation) in SE(3).
-struct Pose {
-  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-
-  [[nodiscard]] Pose operator*(const Pose& b) const { return {q * b.q, p + q * b.p}; }
-  [[nodiscard]] Pose inverse() const { return {q.conjugate(), -(q.conjugate() * p)}; }
-};
-
-/// SE(3) exponential and logarithm for xi = [translation part; rotation vector].
-[[nodiscard]] Pose se3_exp(const Vector6d& xi);
-[[nodiscard]] Vector6d se3_log(const Pose& T);
-/// Adjoint of T for the [translation; rotation] ordering: Exp(Ad(T) xi) = T Exp(xi) T^-1.
-[[nodiscard]] Matrix6d se3_adjoint(const Pose& T);
+// The SE(3) maths (Pose, Exp/Log, adjoint, [translation; rotation] ordering, right perturbation) is canyon's one copy
+// in core/se3.hpp.
+using core::Matrix6d;
+using core::Pose;
+using core::se3_adjoint;
+using core::se3_exp;
+using core::se3_log;
+using core::Vector6d;
 
 struct VioSample {
   std::int64_t t_ns = 0;                       ///< device clock
