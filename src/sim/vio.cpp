@@ -85,8 +85,12 @@ VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std:
       const Matrix6d Q = step_noise(o, dT.p.norm());
       Vector6d n;
       for (int i = 0; i < 6; ++i) n(i) = std::sqrt(Q(i, i)) * rng.normal();
-      estimate = estimate * dT * se3_exp(n);
-      const Matrix6d A = se3_adjoint(dT.inverse());
+      const Pose dT_estimate = dT * se3_exp(n);
+      estimate = estimate * dT_estimate;
+      // Propagated with the VIO's own (estimated) increment, as a VIO filter does: the reported covariances are then
+      // consistent with the reported poses, which matters when a user differences absolute covariances of metres^2 to
+      // get an increment's of millimetres^2 (A from the true increment differs by the increment's noise).
+      const Matrix6d A = se3_adjoint(dT_estimate.inverse());
       s.cross_previous = P * A.transpose();
       P = A * P * A.transpose() + Q;
     }
