@@ -703,6 +703,7 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
       post_fit.worst_sd = row->sd;
     }
   }
+  last_code_rows_ = static_cast<int>(code_rows.size());
   return static_cast<int>(phase_rows.size());
 }
 
@@ -1026,8 +1027,10 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
     has_prior_ = true;
   }
   aiding_ = aiding;
+  last_code_rows_ = 0;
   out.num_dd_measurements = measurement_update(sds, out.rejected);
   out.max_post_fit_normalised = last_post_fit_normalised_;
+  out.num_dd_code_measurements = last_code_rows_;
   if (out.num_dd_measurements == 0) {
     aiding_ = nullptr;
     out.note = "no double-differenced phase";

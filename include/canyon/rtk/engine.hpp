@@ -134,6 +134,7 @@ struct RtkEpoch {
   core::Solution solution;                  ///< status Fixed, Float or Single
   int num_fixed_ambiguities = 0;            ///< DD ambiguities in the accepted fix (0 if not fixed)
   int num_dd_measurements = 0;              ///< DD phase measurements used in the update
+  int num_dd_code_measurements = 0;         ///< DD code measurements used in the update
   std::vector<core::SatelliteId> rejected;  ///< satellites whose measurements failed the innovation gate
   std::string note;                         ///< why the epoch is not fixed, if it is not (for --verbose)
   double hdop = 0.0;                        ///< of the single-point geometry, for NMEA GGA
@@ -269,6 +270,7 @@ class RtkEngine {
   Eigen::MatrixXd prior_P_;
   std::map<DdKey, double> prior_last_fix_;
   double last_post_fit_normalised_ = 0.0;
+  int last_code_rows_ = 0;
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);
