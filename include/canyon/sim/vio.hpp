@@ -34,6 +34,7 @@
 // Gaussian jitter.
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -79,6 +80,28 @@ struct VioRun {
 /// The device's VIO and time sync along the rover trajectory of `scenario` (its city origin and start time). The
 /// same seed gives the same run.
 [[nodiscard]] VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std::uint64_t seed);
+
+/// The VIO of any true body motion: `T_OI_true(t_s)` is the true IMU pose in the odometry frame `T_EO` at t_s
+/// seconds after `start`, for t_s in [0, duration_s]; poses and time sync as simulate_vio() makes them (same clock,
+/// drift and covariance model, same random streams).
+[[nodiscard]] VioRun simulate_vio_along(const VioOptions& options, const core::GpsTime& start, double duration_s,
+                                        const std::function<Pose(double)>& T_OI_true, const Pose& T_EO,
+                                        std::uint64_t seed);
+
+/// One sample of a 6-DoF ground truth: the antenna position and the body attitude R_EI (I: x forward, y left,
+/// z up).
+struct SixDofSample {
+  core::GpsTime time;
+  Eigen::Vector3d p_E_A_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_EI = Eigen::Quaterniond::Identity();
+};
+
+/// The VIO of a device carried along a recorded 6-DoF truth (`canyon simulate --vio-from-truth`): the IMU at
+/// p_E_A - R_EI t_IA (options.t_IA_m), O gravity-aligned (ENU at the first sample rotated by odometry_yaw_deg) with
+/// its origin at the IMU's first position; truth interpolated linearly in position and on SO(3) in attitude. Pose
+/// times span the truth's. Samples must be in time order, at least two.
+[[nodiscard]] VioRun simulate_vio_from_truth(const VioOptions& options, const std::vector<SixDofSample>& truth,
+                                             std::uint64_t seed);
 
 /// Body attitude R_NI at time t_s (seconds since the start): level, x along the walking direction.
 [[nodiscard]] Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s);
