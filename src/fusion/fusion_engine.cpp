@@ -9,6 +9,7 @@
 #include <limits>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
@@ -80,6 +81,7 @@ std::string FusionOptions::validate() const {
   if (max_prior_rejections < 0 || gate_conflict_epochs < 1 || !(reanchor_sigma_m > 0.0)) {
     return "max_prior_rejections must be >= 0, gate_conflict_epochs >= 1 and reanchor_sigma_m > 0";
   }
+  if (!(max_fix_sigma_m > 0.0)) return "max_fix_sigma_m must be > 0";
   if (!(max_post_fit_normalised > 0.0) || !(max_prior_chi2 > 0.0) || !(false_fix_chi2 > 0.0)) {
     return "max_post_fit_normalised, max_prior_chi2 and false_fix_chi2 must be > 0";
   }
@@ -145,14 +147,18 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
   if (options_.gate == InnovationGate::ChiSquare || options_.gate == InnovationGate::Both) {
     aiding.max_normalised_innovation = options_.gate_sigmas;
   }
-  if (options_.false_fix_guard) {
-    const double bound = options_.false_fix_chi2;
-    aiding.accept_fix = [this, prior, bound](const Eigen::Vector3d& p_fix, const Eigen::Matrix3d& P_fix) {
-      if (chi2(p_fix - prior.p_E_m, prior.P_E_m2 + P_fix) <= bound) return true;
-      ++guard_rejections_epoch_;
+  const double bound = options_.false_fix_guard ? options_.false_fix_chi2 : -1.0;
+  const double max_variance = options_.max_fix_sigma_m * options_.max_fix_sigma_m;
+  aiding.accept_fix = [this, prior, bound, max_variance](const Eigen::Vector3d& p_fix, const Eigen::Matrix3d& P_fix) {
+    if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_fix, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff() >
+        max_variance) {
+      ++undetermined_fixes_epoch_;
       return false;
-    };
-  }
+    }
+    if (bound < 0.0 || chi2(p_fix - prior.p_E_m, prior.P_E_m2 + P_fix) <= bound) return true;
+    ++guard_rejections_epoch_;
+    return false;
+  };
   return aiding;
 }
 
@@ -181,6 +187,7 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
   if (alignment_ && pose && pose->segment != alignment_->segment) alignment_.reset();
 
   guard_rejections_epoch_ = 0;
+  undetermined_fixes_epoch_ = 0;
   std::optional<rtk::RtkAiding> aiding = make_aiding(rover.time, pose);
   core::ObsEpoch screened;
   const core::ObsEpoch* observed = &rover;
@@ -191,6 +198,7 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
     observed = &screened;
   }
   auto result = engine_.process(*observed, base, aiding ? &*aiding : nullptr);
+  if (undetermined_fixes_epoch_ > 0) ++stats_.undetermined_fix_epochs;
   if (guard_rejections_epoch_ > 0) {
     ++stats_.guard_epochs;
     stats_.guard_candidates += guard_rejections_epoch_;
@@ -362,7 +370,8 @@ std::vector<std::string> FusionEngine::report() const {
   lines.push_back(format("fusion: false-fix guard fired in %.0f epochs (%.0f candidate fixes); %.0f fixes after ILS "
                          "pruning; %.0f DD rows gated",
                          s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
-                  format("; %.0f signals screened out by C/N0", s.cn0_screened));
+                  format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of an undetermined position",
+                         s.cn0_screened, s.undetermined_fix_epochs));
   int coarse = 0, fine = 0;
   for (const AlignmentEvent& a : s.alignments) (a.kind == "coarse" ? coarse : fine) += 1;
   lines.push_back(format("fusion: alignments: %.0f fine of %.0f windows tried (%.0f with FER >= the limit, ", fine,

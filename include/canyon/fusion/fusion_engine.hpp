@@ -28,7 +28,8 @@
 //  6. MLAMBDA with the ratio test (rtk options, 3.0); when it fails the engine prunes the satellite with the largest
 //     integer least-squares residual and solves again (Algorithm 1, lines 13-19; rtk partial_ar). Beyond the paper,
 //     a false-fix guard rejects a candidate fix whose position disagrees with the prior:
-//     (p_fix - p_prior)^T (P_prior + P_fix)^-1 (p_fix - p_prior) > false_fix_chi2.
+//     (p_fix - p_prior)^T (P_prior + P_fix)^-1 (p_fix - p_prior) > false_fix_chi2, and a fix whose position sigma
+//     (largest axis of P_fix) exceeds max_fix_sigma_m (integers fixed, position not: three satellites).
 //  7. Output: fixed, else float (Algorithm 1).
 // Prediction "constant_velocity" (an ablation) replaces the VIO increment by v dt from the last two solutions, with
 // covariance (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
@@ -75,7 +76,7 @@ struct FusionOptions {
   Prediction prediction = Prediction::Vio;
   bool vio_covariance = true;                ///< Eqs. 4-6; false: constant_increment_sigma_m per axis (ablation)
   double constant_increment_sigma_m = 0.05;  ///< (m)
-  InnovationGate gate = InnovationGate::Paper;
+  InnovationGate gate = InnovationGate::Both;
   double gate_motion_factor = 5.0;       ///< paper: 5 x the VIO incremental motion
   double min_gate_m = 0.5;               ///< the motion gate is at least this (standing still) (m)
   double gate_sigmas = 4.0;              ///< chi-square gate: |v| <= this x sqrt(h P h^T + r)
@@ -83,7 +84,9 @@ struct FusionOptions {
   double max_prior_chi2 = 16.27;         ///< float validation: chi-square(3) of the float against the prior (0.999)
   bool false_fix_guard = true;           ///< beyond the paper: fixes must agree with the prior
   double false_fix_chi2 = 16.27;         ///< chi-square(3) bound of the guard (0.999)
-  Cn0ScreenOptions cn0;                  ///< beyond the paper: NLOS screening by C/N0 (cn0_screen.hpp)
+  double max_fix_sigma_m = 0.1;          ///< a fix whose position sigma (largest axis) exceeds this is not taken:
+                                         ///< its DD geometry leaves the position undetermined (too few satellites)
+  Cn0ScreenOptions cn0{false};           ///< beyond the paper: NLOS screening by C/N0 (cn0_screen.hpp), off
   int max_prior_rejections = 5;          ///< after this many consecutive epochs whose float failed only the prior
                                          ///< check, the float is taken: GNSS re-anchors a drifted VIO prior
   int gate_conflict_epochs = 5;          ///< after this many consecutive epochs in which the gates rejected more DD
@@ -120,13 +123,14 @@ struct FusionStats {
   int float_rejected_no_phase = 0;
   int float_rejected_post_fit = 0;
   int float_rejected_prior = 0;
-  int guard_epochs = 0;      ///< epochs in which the false-fix guard rejected at least one candidate
-  int guard_candidates = 0;  ///< candidate fixes it rejected
-  int gated_rows = 0;        ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
-  int cn0_screened = 0;      ///< signals removed by the C/N0 screen
-  int ar_pruned_epochs = 0;  ///< fixes obtained after pruning satellites by their ILS residual
-  int reanchored = 0;        ///< floats taken after max_prior_rejections (the prior had drifted)
-  int widened = 0;           ///< priors widened after gate_conflict_epochs
+  int guard_epochs = 0;             ///< epochs in which the false-fix guard rejected at least one candidate
+  int guard_candidates = 0;         ///< candidate fixes it rejected
+  int gated_rows = 0;               ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
+  int cn0_screened = 0;             ///< signals removed by the C/N0 screen
+  int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its undetermined position
+  int ar_pruned_epochs = 0;         ///< fixes obtained after pruning satellites by their ILS residual
+  int reanchored = 0;               ///< floats taken after max_prior_rejections (the prior had drifted)
+  int widened = 0;                  ///< priors widened after gate_conflict_epochs
   int alignment_tries = 0;
   int alignment_rejected_fer = 0;
   int alignment_rejected_rmse = 0;
@@ -191,6 +195,7 @@ class FusionEngine {
   std::optional<core::GpsTime> last_coarse_try_;
   std::optional<Prior> prior_;  // of the epoch being processed
   int guard_rejections_epoch_ = 0;
+  int undetermined_fixes_epoch_ = 0;
   int prior_rejections_ = 0;  // consecutive
   int gate_conflicts_ = 0;    // consecutive
   bool widen_next_prior_ = false;
