@@ -128,6 +128,7 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
     const double dt = t - t_state;
     if (!(dt_k > 0.0) || dt_k > 5.0 || dt < 0.0) return std::nullopt;
     const Eigen::Vector3d v = (b.p_E_m - a.p_E_m) / dt_k;
+    if (!(v.norm() <= options_.vio.max_speed_mps)) return std::nullopt;  // a jump between solutions, not a motion
     aiding.delta_p_E_m = v * dt;
     const double sa = rtk_options_.accel_sigma_h_mps2;
     aiding.Q_E_m2 =
@@ -273,7 +274,7 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
   }
   const double keep_s = std::max({options_.alignment_window_s, options_.coarse_window_s}) + 1.0;
   while (!history_.empty() && rover.time - history_.front().time > keep_s) history_.erase(history_.begin());
-  if (out.solution.status != core::SolutionStatus::None) {
+  if (out.solution.status == core::SolutionStatus::Fixed || out.solution.status == core::SolutionStatus::Float) {
     last_solutions_.push_back(out.solution);
     if (last_solutions_.size() > 2) last_solutions_.erase(last_solutions_.begin());
   }

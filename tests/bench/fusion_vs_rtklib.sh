@@ -76,6 +76,7 @@ timed() {
 }
 # "fix% avail% wrong rmse" of label $2 in evaluation.json $1.
 figures() {
+  [[ -s $1 ]] || { echo "- - - -"; return; }
   python3 - "$1" "$2" <<'EOF'
 import json, sys
 report = json.load(open(sys.argv[1]))
@@ -106,7 +107,7 @@ for scenario in "${scenarios[@]}"; do
       --out "$dir/fusion.pos" 2>"$dir/fusion.log" || true
     "$canyon" evaluate -q --truth "$dir/truth.csv" --rover "$dir/rover.obs" --city "$dir/city.geojson" \
       --solution "$dir/rtklib.pos" --label RTKLIB --solution "$dir/rtk.pos" --label "canyon rtk" \
-      --solution "$dir/fusion.pos" --label "canyon fusion" --out-dir "$dir/evaluation"
+      --solution "$dir/fusion.pos" --label "canyon fusion" --out-dir "$dir/evaluation" || true
     json=$dir/evaluation/evaluation.json
     read -r a1 a2 a3 a4 <<<"$(figures "$json" RTKLIB)"
     read -r b1 b2 b3 b4 <<<"$(figures "$json" "canyon rtk")"
@@ -140,7 +141,7 @@ if [[ ${ABLATIONS:-1} != 0 ]]; then
         "$canyon" process -q --config "$tmp/fusion-$name.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
           --nav "$dir/nav.rnx" --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" --out "$out.pos" || true
         "$canyon" evaluate -q --truth "$dir/truth.csv" --rover "$dir/rover.obs" --solution "$out.pos" \
-          --label "$name" --json "$out.json"
+          --label "$name" --json "$out.json" || rm -f "$out.json"
         read -r f1 f2 f3 f4 <<<"$(figures "$out.json" "$name")"
         printf ' | %-30s' "$(cell "$f1" "$f2" "$f3" "$f4")"
       done
@@ -194,7 +195,7 @@ s/^ant2-pos3 .*/ant2-pos3          =4774767.03105544/" "$tmp/instinct-rtklib.con
       t2=$(now)
       "$canyon" evaluate -q --truth "$inst/Rover-dynamic_PVA_Spirent.csv" --epochs 601 \
         --solution "$dir/rtklib.pos" --label RTKLIB --solution "$dir/rtk.pos" --label "canyon rtk" \
-        --solution "$dir/fusion.pos" --label "canyon fusion" --out-dir "$dir/evaluation"
+        --solution "$dir/fusion.pos" --label "canyon fusion" --out-dir "$dir/evaluation" || true
       json=$dir/evaluation/evaluation.json
       read -r a1 a2 a3 a4 <<<"$(figures "$json" RTKLIB)"
       read -r b1 b2 b3 b4 <<<"$(figures "$json" "canyon rtk")"

@@ -31,8 +31,9 @@
 //     (p_fix - p_prior)^T (P_prior + P_fix)^-1 (p_fix - p_prior) > false_fix_chi2, and a fix whose position sigma
 //     (largest axis of P_fix) exceeds max_fix_sigma_m (integers fixed, position not: three satellites).
 //  7. Output: fixed, else float (Algorithm 1).
-// Prediction "constant_velocity" (an ablation) replaces the VIO increment by v dt from the last two solutions, with
-// covariance (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
+// Prediction "constant_velocity" (an ablation) replaces the VIO increment by v dt from the last two fixed or float
+// solutions (none if they are more than 5 s apart or imply more than vio_max_speed_mps), with covariance
+// (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
 
 #include <optional>
 #include <string>
