@@ -23,31 +23,104 @@ namespace {
 
 constexpr std::size_t kMaxEpochNotes = 100;
 
-/// The epochs of an observation file as observations: flag 6 epochs hold cycle-slip records (slip counts in the
-/// observation fields), not observations, and are dropped; after a power failure (flag 1) every phase may have
-/// slipped and gets the loss-of-lock bit. One warning per file for each.
-void keep_observations(io::RinexObsFile& file, const std::string& path, std::vector<std::string>& warnings) {
-  const auto slip_records = std::count_if(file.epochs.begin(), file.epochs.end(), [](const core::ObsEpoch& e) {
-    return e.flag == core::EpochFlag::CycleSlipRecords;
-  });
-  if (slip_records > 0) {
-    std::erase_if(file.epochs, [](const core::ObsEpoch& e) { return e.flag == core::EpochFlag::CycleSlipRecords; });
-    warnings.push_back(path + ": " + std::to_string(slip_records) +
-                       " epochs of cycle-slip records (flag 6) are not observations, not used");
+/// An observation file read epoch by epoch as observations: flag 6 epochs hold cycle-slip records (slip counts in
+/// the observation fields), not observations, and are dropped; after a power failure (flag 1) every phase may have
+/// slipped and gets the loss-of-lock bit. Streaming keeps memory flat however long the file is.
+class ObservationStream {
+ public:
+  static Result<ObservationStream> open(const std::string& path, const io::ObsFilter& filter) {
+    auto reader = io::RinexObsReader::open(path, filter);
+    if (!reader) return reader.error();
+    return ObservationStream(std::move(*reader), path);
   }
-  int power_failures = 0;
-  for (core::ObsEpoch& epoch : file.epochs) {
-    if (epoch.flag != core::EpochFlag::PowerFailure) continue;
-    ++power_failures;
-    for (core::SatelliteObs& sat : epoch.sats) {
-      for (core::SignalObs& signal : sat.signals) signal.lli |= core::kLliLossOfLock;
+
+  /// The next epoch of observations; nullopt at the end of the file.
+  Result<std::optional<core::ObsEpoch>> next() {
+    for (;;) {
+      auto epoch = reader_.next();
+      if (!epoch) return epoch.error();
+      if (!*epoch) return std::optional<core::ObsEpoch>{};
+      core::ObsEpoch& e = **epoch;
+      if (e.flag == core::EpochFlag::CycleSlipRecords) {
+        ++slip_records_;
+        continue;
+      }
+      if (e.flag == core::EpochFlag::PowerFailure) {
+        ++power_failures_;
+        for (core::SatelliteObs& sat : e.sats) {
+          for (core::SignalObs& signal : sat.signals) signal.lli |= core::kLliLossOfLock;
+        }
+      }
+      if (!first_time_) first_time_ = e.time;
+      last_time_ = e.time;
+      return std::move(*epoch);
     }
   }
-  if (power_failures > 0) {
-    warnings.push_back(path + ": " + std::to_string(power_failures) +
-                       " epochs after a power failure (flag 1): all their phases taken as lost lock");
+
+  [[nodiscard]] const io::RinexObsHeader& header() const { return reader_.header(); }
+  [[nodiscard]] double fraction_read() const { return reader_.fraction_read(); }
+  [[nodiscard]] const std::optional<core::GpsTime>& first_time() const { return first_time_; }
+  [[nodiscard]] const std::optional<core::GpsTime>& last_time() const { return last_time_; }
+
+  /// The reader's warnings and one for each kind of epoch handled above (call at the end).
+  void append_warnings(std::vector<std::string>& out) const {
+    out.insert(out.end(), reader_.warnings().begin(), reader_.warnings().end());
+    if (slip_records_ > 0) {
+      out.push_back(path_ + ": " + std::to_string(slip_records_) +
+                    " epochs of cycle-slip records (flag 6) are not observations, not used");
+    }
+    if (power_failures_ > 0) {
+      out.push_back(path_ + ": " + std::to_string(power_failures_) +
+                    " epochs after a power failure (flag 1): all their phases taken as lost lock");
+    }
   }
-}
+
+ private:
+  ObservationStream(io::RinexObsReader reader, std::string path) : reader_(std::move(reader)), path_(std::move(path)) {}
+
+  io::RinexObsReader reader_;
+  std::string path_;
+  int slip_records_ = 0;
+  int power_failures_ = 0;
+  std::optional<core::GpsTime> first_time_;
+  std::optional<core::GpsTime> last_time_;
+};
+
+/// The base epochs, read one ahead of the one in use: at rover time t, the latest base epoch not later than t (plus
+/// a small tolerance for receivers whose time tags differ by milliseconds), or nullptr.
+class BaseCursor {
+ public:
+  explicit BaseCursor(ObservationStream stream) : stream_(std::move(stream)) {}
+
+  Result<const core::ObsEpoch*> at(const core::GpsTime& t) {
+    constexpr double kToleranceS = 0.05;
+    if (!primed_) {
+      if (Status s = read_next(); !s) return s.error();
+      primed_ = true;
+    }
+    while (next_ && next_->time - t <= kToleranceS) {
+      current_ = std::move(next_);
+      if (Status s = read_next(); !s) return s.error();
+    }
+    if (current_ && current_->time - t <= kToleranceS) return &*current_;
+    return nullptr;
+  }
+
+  [[nodiscard]] const ObservationStream& stream() const { return stream_; }
+
+ private:
+  Status read_next() {
+    auto epoch = stream_.next();
+    if (!epoch) return epoch.error();
+    next_ = std::move(*epoch);
+    return Ok{};
+  }
+
+  ObservationStream stream_;
+  std::optional<core::ObsEpoch> current_;
+  std::optional<core::ObsEpoch> next_;
+  bool primed_ = false;
+};
 
 Result<core::NavigationData> read_navigation(const std::vector<std::string>& paths,
                                              std::vector<std::string>& warnings) {
@@ -87,13 +160,58 @@ bool is_tracked(const core::SatelliteObs& sat) {
   });
 }
 
-/// Applies `exclude_most_observed`: the satellites join both modes' exclusion lists. Returns them.
-std::vector<core::SatelliteId> exclude_most_observed(ProcessConfig& config, const std::vector<core::ObsEpoch>& rover) {
-  if (config.exclude_most_observed <= 0) return {};
+/// Tracking counts per satellite over epochs, for `exclude_most_observed`.
+class SatelliteTally {
+ public:
+  explicit SatelliteTally(const core::ConstellationFlags& systems)
+      : systems_(systems), count_(core::kMaxSatellites, 0), seen_(core::kMaxSatellites) {}
+
+  void add(const core::ObsEpoch& epoch) {
+    for (const core::SatelliteObs& sat : epoch.sats) {
+      if (!sat.sat.valid() || !systems_.uses(sat.sat.system) || !is_tracked(sat)) continue;
+      const int i = sat.sat.index();
+      ++count_[static_cast<std::size_t>(i)];
+      seen_[static_cast<std::size_t>(i)] = sat.sat;
+    }
+  }
+
+  /// The `n` most tracked, most first; ties go to the lower satellite id.
+  [[nodiscard]] std::vector<core::SatelliteId> most(int n) const {
+    std::vector<core::SatelliteId> sats;
+    for (std::size_t i = 0; i < count_.size(); ++i) {
+      if (count_[i] > 0) sats.push_back(seen_[i]);
+    }
+    const auto count = [this](const core::SatelliteId& s) { return count_[static_cast<std::size_t>(s.index())]; };
+    std::stable_sort(sats.begin(), sats.end(), [&count](const core::SatelliteId& a, const core::SatelliteId& b) {
+      return count(a) > count(b) || (count(a) == count(b) && a < b);
+    });
+    if (static_cast<int>(sats.size()) > n) sats.resize(static_cast<std::size_t>(std::max(n, 0)));
+    return sats;
+  }
+
+ private:
+  core::ConstellationFlags systems_;
+  std::vector<int> count_;
+  std::vector<core::SatelliteId> seen_;
+};
+
+/// Applies `exclude_most_observed` with a first pass over the rover file: the satellites join both modes'
+/// exclusion lists. Returns them.
+Result<std::vector<core::SatelliteId>> exclude_most_observed(ProcessConfig& config, const io::ObsFilter& filter) {
+  if (config.exclude_most_observed <= 0) return std::vector<core::SatelliteId>{};
   const core::ConstellationFlags& systems = config.mode != ProcessMode::Spp
                                                 ? static_cast<const core::ConstellationFlags&>(config.rtk.observables)
                                                 : static_cast<const core::ConstellationFlags&>(config.spp);
-  std::vector<core::SatelliteId> sats = most_observed_satellites(rover, config.exclude_most_observed, systems);
+  auto rover = ObservationStream::open(config.rover_obs, filter);
+  if (!rover) return rover.error();
+  SatelliteTally tally(systems);
+  for (;;) {
+    auto epoch = rover->next();
+    if (!epoch) return epoch.error();
+    if (!*epoch) break;
+    tally.add(**epoch);
+  }
+  std::vector<core::SatelliteId> sats = tally.most(config.exclude_most_observed);
   for (const core::SatelliteId& sat : sats) {
     config.spp.excluded.push_back(sat);
     config.rtk.observables.excluded.push_back(sat);
@@ -124,16 +242,6 @@ std::vector<std::string> header_lines(const ProcessConfig& config,
     lines.push_back(std::move(line));
   }
   return lines;
-}
-
-/// The base epoch to use at rover time t: the latest one not later than t (plus a small tolerance for receivers
-/// whose time tags differ by milliseconds), or nullptr.
-const core::ObsEpoch* base_epoch_at(const std::vector<core::ObsEpoch>& base, std::size_t& cursor,
-                                    const core::GpsTime& t) {
-  constexpr double kToleranceS = 0.05;
-  while (cursor + 1 < base.size() && base[cursor + 1].time - t <= kToleranceS) ++cursor;
-  if (cursor < base.size() && base[cursor].time - t <= kToleranceS) return &base[cursor];
-  return nullptr;
 }
 
 core::Solution to_solution(const gnss::SppSolution& spp) {
@@ -186,12 +294,19 @@ const char* status_word(core::SolutionStatus status) {
   }
 }
 
-Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
-               const std::vector<core::ObsEpoch>& rover, Outputs& writer, ProcessSummary& summary,
-               const ProgressFn& progress) {
+/// Reports progress (epochs done, fraction of the rover file read).
+void report(const ProgressFn& progress, const ProcessSummary& summary, const ObservationStream& rover) {
+  if (progress) progress(summary.epochs, rover.fraction_read());
+}
+
+Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
+               Outputs& writer, ProcessSummary& summary, const ProgressFn& progress) {
   std::optional<Eigen::Vector3d> last_p_E;
-  const int total = static_cast<int>(rover.size());
-  for (const core::ObsEpoch& epoch : rover) {
+  for (;;) {
+    auto next = rover.next();
+    if (!next) return next.error();
+    if (!*next) break;
+    const core::ObsEpoch& epoch = **next;
     ++summary.epochs;
     auto sol = gnss::solve_spp(epoch, ephemerides, config.spp, last_p_E);
     if (sol) {
@@ -201,21 +316,24 @@ Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
     } else {
       add_epoch_note(summary, epoch.time, "no solution", sol.error().message);
     }
-    if (progress) progress(summary.epochs, total);
+    report(progress, summary, rover);
   }
   return Ok{};
 }
 
-Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
-               const std::vector<core::ObsEpoch>& rover, const std::vector<core::ObsEpoch>& base,
-               const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary, const ProgressFn& progress) {
-  rtk::RtkOptions options = config.rtk;
-  rtk::RtkEngine engine(options, ephemerides, p_E_base);
-  std::size_t cursor = 0;
-  const int total = static_cast<int>(rover.size());
-  for (const core::ObsEpoch& epoch : rover) {
+Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
+               BaseCursor& base, const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
+               const ProgressFn& progress) {
+  rtk::RtkEngine engine(config.rtk, ephemerides, p_E_base);
+  for (;;) {
+    auto next = rover.next();
+    if (!next) return next.error();
+    if (!*next) break;
+    const core::ObsEpoch& epoch = **next;
     ++summary.epochs;
-    auto result = engine.process(epoch, base_epoch_at(base, cursor, epoch.time));
+    auto base_epoch = base.at(epoch.time);
+    if (!base_epoch) return base_epoch.error();
+    auto result = engine.process(epoch, *base_epoch);
     if (result) {
       if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
       ++summary.solved;
@@ -226,7 +344,7 @@ Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
     } else {
       add_epoch_note(summary, epoch.time, "no solution", result.error().message);
     }
-    if (progress) progress(summary.epochs, total);
+    report(progress, summary, rover);
   }
   return Ok{};
 }
@@ -239,9 +357,8 @@ std::string gps_text(const core::GpsTime& t) {
 }
 
 /// The VIO trajectory on GPST: vio.csv through the time bridge (timesync.csv, unless the VIO is on GPST), split into
-/// segments. Error (naming the file) when the VIO does not overlap the rover epochs at all.
-Result<fusion::VioTrack> load_vio(const ProcessConfig& config, const std::vector<core::ObsEpoch>& rover,
-                                  ProcessSummary& summary) {
+/// segments.
+Result<fusion::VioTrack> load_vio(const ProcessConfig& config, ProcessSummary& summary) {
   auto vio = io::read_vio_csv(config.vio);
   if (!vio) return vio.error();
   summary.warnings.insert(summary.warnings.end(), vio->warnings.begin(), vio->warnings.end());
@@ -282,29 +399,32 @@ Result<fusion::VioTrack> load_vio(const ProcessConfig& config, const std::vector
   auto track = fusion::VioTrack::build(*vio, bridge, config.fusion.vio, notes);
   if (!track) return Error{track.error().message, config.vio, 0};
   for (const std::string& n : notes) summary.report.push_back("fusion: " + n);
-  if (!rover.empty() &&
-      (track->last_time() - rover.front().time < 0.0 || rover.back().time - track->first_time() < 0.0)) {
-    return Error{"the VIO (GPST " + gps_text(track->first_time()) + " to " + gps_text(track->last_time()) +
-                     ") does not overlap the rover epochs (GPST " + gps_text(rover.front().time) + " to " +
-                     gps_text(rover.back().time) + "): wrong file, or wrong time sync" +
-                     (config.fusion.vio_on_gps_time ? " (vio_clock: gps)" : ""),
-                 config.vio, 0};
-  }
   return track;
 }
 
-Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides,
-                  const std::vector<core::ObsEpoch>& rover, const std::vector<core::ObsEpoch>& base,
-                  const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
+Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
+                  BaseCursor& base, const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
                   const ProgressFn& progress) {
-  auto track = load_vio(config, rover, summary);
+  auto track = load_vio(config, summary);
   if (!track) return track.error();
+  const core::GpsTime vio_first = track->first_time();
+  const core::GpsTime vio_last = track->last_time();
   fusion::FusionEngine engine(config.fusion, config.rtk, ephemerides, p_E_base, std::move(*track));
-  std::size_t cursor = 0;
-  const int total = static_cast<int>(rover.size());
-  for (const core::ObsEpoch& epoch : rover) {
+  std::optional<core::GpsTime> first;
+  core::GpsTime last;
+  int overlapping = 0;
+  for (;;) {
+    auto next = rover.next();
+    if (!next) return next.error();
+    if (!*next) break;
+    const core::ObsEpoch& epoch = **next;
+    if (!first) first = epoch.time;
+    last = epoch.time;
+    if (!(epoch.time < vio_first) && !(vio_last < epoch.time)) ++overlapping;
     ++summary.epochs;
-    auto result = engine.process(epoch, base_epoch_at(base, cursor, epoch.time));
+    auto base_epoch = base.at(epoch.time);
+    if (!base_epoch) return base_epoch.error();
+    auto result = engine.process(epoch, *base_epoch);
     if (result) {
       if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
       ++summary.solved;
@@ -316,10 +436,16 @@ Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephem
     } else {
       add_epoch_note(summary, epoch.time, "no solution", result.error().message);
     }
-    if (progress) progress(summary.epochs, total);
+    report(progress, summary, rover);
   }
-  const std::vector<std::string> report = engine.report();
-  summary.report.insert(summary.report.end(), report.begin(), report.end());
+  if (first && overlapping == 0) {
+    return Error{"the VIO (GPST " + gps_text(vio_first) + " to " + gps_text(vio_last) +
+                     ") does not overlap the rover epochs (GPST " + gps_text(*first) + " to " + gps_text(last) +
+                     "): wrong file, or wrong time sync" + (config.fusion.vio_on_gps_time ? " (vio_clock: gps)" : ""),
+                 config.vio, 0};
+  }
+  const std::vector<std::string> lines = engine.report();
+  summary.report.insert(summary.report.end(), lines.begin(), lines.end());
   return Ok{};
 }
 
@@ -327,26 +453,33 @@ Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephem
 
 std::vector<core::SatelliteId> most_observed_satellites(const std::vector<core::ObsEpoch>& epochs, int n,
                                                         const core::ConstellationFlags& systems) {
-  std::vector<int> count(core::kMaxSatellites, 0);
-  std::vector<core::SatelliteId> seen(core::kMaxSatellites);
-  for (const core::ObsEpoch& epoch : epochs) {
-    for (const core::SatelliteObs& sat : epoch.sats) {
-      if (!sat.sat.valid() || !systems.uses(sat.sat.system) || !is_tracked(sat)) continue;
-      const int i = sat.sat.index();
-      ++count[i];
-      seen[i] = sat.sat;
-    }
-  }
-  std::vector<core::SatelliteId> sats;
-  for (int i = 0; i < core::kMaxSatellites; ++i) {
-    if (count[i] > 0) sats.push_back(seen[i]);
-  }
-  std::stable_sort(sats.begin(), sats.end(), [&count](const core::SatelliteId& a, const core::SatelliteId& b) {
-    return count[a.index()] > count[b.index()] || (count[a.index()] == count[b.index()] && a < b);
-  });
-  if (static_cast<int>(sats.size()) > n) sats.resize(static_cast<std::size_t>(std::max(n, 0)));
-  return sats;
+  SatelliteTally tally(systems);
+  for (const core::ObsEpoch& epoch : epochs) tally.add(epoch);
+  return tally.most(n);
 }
+
+namespace {
+
+/// What the observation files are read for: the constellations of either solution, and the frequencies the mode
+/// uses (single point: the first; RTK: as configured). The rest is not parsed.
+io::ObsFilter observation_filter(const ProcessConfig& config) {
+  io::ObsFilter filter;
+  const core::ConstellationFlags& spp = config.spp;
+  filter.systems = spp;
+  filter.max_frequency_rank = 0;
+  if (config.mode != ProcessMode::Spp) {
+    const core::ConstellationFlags& rtk = config.rtk.observables;
+    filter.systems.use_gps = spp.use_gps || rtk.use_gps;
+    filter.systems.use_glonass = spp.use_glonass || rtk.use_glonass;
+    filter.systems.use_galileo = spp.use_galileo || rtk.use_galileo;
+    filter.systems.use_beidou = spp.use_beidou || rtk.use_beidou;
+    filter.systems.use_qzss = spp.use_qzss || rtk.use_qzss;
+    filter.max_frequency_rank = config.rtk.observables.num_frequencies - 1;
+  }
+  return filter;
+}
+
+}  // namespace
 
 Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress) {
   const auto start = std::chrono::steady_clock::now();
@@ -358,38 +491,32 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   if (!nav) return nav.error();
   const gnss::EphemerisStore ephemerides(std::move(*nav));
 
-  auto rover = io::read_rinex_obs(config.rover_obs);
+  const io::ObsFilter filter = observation_filter(config);
+  auto excluded = exclude_most_observed(config, filter);
+  if (!excluded) return excluded.error();
+  summary.excluded_most_observed = std::move(*excluded);
+  auto rover = ObservationStream::open(config.rover_obs, filter);
   if (!rover) return rover.error();
-  summary.warnings.insert(summary.warnings.end(), rover->warnings.begin(), rover->warnings.end());
-  keep_observations(*rover, config.rover_obs, summary.warnings);
-  summary.excluded_most_observed = exclude_most_observed(config, rover->epochs);
 
-  std::optional<io::RinexObsFile> base;
+  std::optional<BaseCursor> base;
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
   if (config.mode != ProcessMode::Spp) {
-    auto base_file = io::read_rinex_obs(config.base_obs);
-    if (!base_file) return base_file.error();
-    summary.warnings.insert(summary.warnings.end(), base_file->warnings.begin(), base_file->warnings.end());
-    keep_observations(*base_file, config.base_obs, summary.warnings);
+    auto base_stream = ObservationStream::open(config.base_obs, filter);
+    if (!base_stream) return base_stream.error();
     if (config.base_position_E_m) {
       p_E_base = *config.base_position_E_m;
-    } else if (base_file->header.receiver.approx_position_E_m) {
-      p_E_base = *base_file->header.receiver.approx_position_E_m;
+    } else if (base_stream->header().receiver.approx_position_E_m) {
+      p_E_base = *base_stream->header().receiver.approx_position_E_m;
     } else {
       return Error{
           "no base position: the base file has no APPROX POSITION XYZ; give --base-pos X,Y,Z or "
           "'base_position:'",
           config.base_obs, 0};
     }
-    if (!rover->epochs.empty() && !base_file->epochs.empty() &&
-        std::abs(rover->epochs.front().time - base_file->epochs.front().time) > 86400.0 &&
-        std::abs(rover->epochs.back().time - base_file->epochs.back().time) > 86400.0) {
-      summary.warnings.push_back(config.base_obs + ": base observations do not overlap the rover's (another day?)");
-    }
-    if (std::string w = glonass_ar_warning(config, rover->header, base_file->header); !w.empty()) {
+    if (std::string w = glonass_ar_warning(config, rover->header(), base_stream->header()); !w.empty()) {
       summary.warnings.push_back(std::move(w));
     }
-    base = std::move(*base_file);
+    base.emplace(std::move(*base_stream));
   }
 
   auto pos = io::PosWriter::create(
@@ -404,15 +531,24 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   Status run = Ok{};
   switch (config.mode) {
     case ProcessMode::Rtk:
-      run = run_rtk(config, ephemerides, rover->epochs, base->epochs, p_E_base, outputs, summary, progress);
+      run = run_rtk(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress);
       break;
     case ProcessMode::Fusion:
-      run = run_fusion(config, ephemerides, rover->epochs, base->epochs, p_E_base, outputs, summary, progress);
+      run = run_fusion(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress);
       break;
-    case ProcessMode::Spp: run = run_spp(config, ephemerides, rover->epochs, outputs, summary, progress); break;
+    case ProcessMode::Spp: run = run_spp(config, ephemerides, *rover, outputs, summary, progress); break;
   }
   if (!run) return run.error();
   if (Status c = outputs.close(); !c) return c.error();
+  rover->append_warnings(summary.warnings);
+  if (base) {
+    const ObservationStream& b = base->stream();
+    b.append_warnings(summary.warnings);
+    if (rover->first_time() && b.first_time() && std::abs(*rover->first_time() - *b.first_time()) > 86400.0 &&
+        std::abs(*rover->last_time() - *b.last_time()) > 86400.0) {
+      summary.warnings.push_back(config.base_obs + ": base observations do not overlap the rover's (another day?)");
+    }
+  }
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

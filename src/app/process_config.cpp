@@ -94,6 +94,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("max_phase_innovation_m", o.max_phase_innovation_m);
   map.get("max_code_innovation_m", o.max_code_innovation_m);
   map.get("max_post_fit_sigmas", o.max_post_fit_sigmas);
+  map.get("max_post_fit_code_sigmas", o.max_post_fit_code_sigmas);
   map.get("max_post_fit_rejections", o.max_post_fit_rejections);
   map.get("hold_sigma_cyc", o.hold_sigma_cyc);
   map.get("max_outage_s", o.max_outage_s);
@@ -366,6 +367,7 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "max_phase_innovation_m" << YAML::Value << o.max_phase_innovation_m;
   out << YAML::Key << "max_code_innovation_m" << YAML::Value << o.max_code_innovation_m;
   out << YAML::Key << "max_post_fit_sigmas" << YAML::Value << o.max_post_fit_sigmas;
+  out << YAML::Key << "max_post_fit_code_sigmas" << YAML::Value << o.max_post_fit_code_sigmas;
   out << YAML::Key << "max_post_fit_rejections" << YAML::Value << o.max_post_fit_rejections;
   out << YAML::Key << "hold_sigma_cyc" << YAML::Value << o.hold_sigma_cyc;
   out << YAML::Key << "max_outage_s" << YAML::Value << o.max_outage_s;

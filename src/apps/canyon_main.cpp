@@ -1,6 +1,7 @@
 // The `canyon` command: subcommands for canyon's jobs. Exit codes: 0 success, 1 bad input or failed run,
 // 2 bad command line or configuration.
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
@@ -27,17 +28,20 @@ constexpr int kExitUsage = 2;
 class ProgressBar {
  public:
   explicit ProgressBar(bool enabled) : enabled_(enabled && isatty(fileno(stderr)) != 0) {}
-  void update(int done, int total) {
-    if (!enabled_ || total <= 0) return;
-    const int percent = static_cast<int>(100LL * done / total);
-    if (percent == last_percent_ && done != total) return;
+  void update(int epochs, double fraction) {
+    if (!enabled_) return;
+    const int percent = static_cast<int>(100.0 * std::clamp(fraction, 0.0, 1.0));
+    if (percent == last_percent_ && fraction < 1.0) return;
     last_percent_ = percent;
     constexpr int kWidth = 40;
-    const int filled = kWidth * done / total;
-    std::fprintf(stderr, "\r[%.*s%*s] %3d%% %d/%d epochs", filled, "########################################",
-                 kWidth - filled, "", percent, done, total);
-    if (done == total) std::fprintf(stderr, "\n");
+    const int filled = kWidth * percent / 100;
+    std::fprintf(stderr, "\r[%.*s%*s] %3d%% %d epochs", filled, "########################################",
+                 kWidth - filled, "", percent, epochs);
     std::fflush(stderr);
+  }
+  /// Ends the bar's line (after the last update).
+  void finish() {
+    if (enabled_ && last_percent_ >= 0) std::fprintf(stderr, "\n");
   }
 
  private:
@@ -163,7 +167,9 @@ int run_process_command(const ProcessArgs& args) {
     return kExitUsage;
   }
   ProgressBar bar(!args.quiet);
-  auto summary = canyon::app::run_process(config, [&bar](int done, int total) { bar.update(done, total); });
+  auto summary =
+      canyon::app::run_process(config, [&bar](int epochs, double fraction) { bar.update(epochs, fraction); });
+  bar.finish();
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;

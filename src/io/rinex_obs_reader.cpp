@@ -192,10 +192,12 @@ struct RinexObsReader::Mapping {
   struct Column {
     std::int8_t signal = -1;  // index into `signals`, -1 for a column canyon ignores
     ObsKind kind = ObsKind::None;
-    double scale = 1.0;  // "SYS / SCALE FACTOR": the file holds value * scale
+    double scale = 1.0;     // "SYS / SCALE FACTOR": the file holds value * scale
+    bool filtered = false;  // left out by the reader's filter: not even parsed
   };
   struct System {
     bool declared = false;
+    bool filtered = false;  // the whole system is left out by the reader's filter
     std::vector<Column> columns;
     std::vector<core::SignalCode> signals;
   };
@@ -207,10 +209,11 @@ struct RinexObsReader::Mapping {
 // ---------------------------------------------------------------------------------------------------------------
 // Header
 
-Result<RinexObsReader> RinexObsReader::open(const std::string& path) {
+Result<RinexObsReader> RinexObsReader::open(const std::string& path, std::optional<ObsFilter> filter) {
   auto text = TextReader::open(path);
   if (!text.ok()) return text.error();
   RinexObsReader reader(std::move(text).value());
+  reader.filter_ = filter;
   if (Status s = reader.read_header(); !s.ok()) return s.error();
   return reader;
 }
@@ -532,6 +535,7 @@ void RinexObsReader::build_mapping() {
   for (const auto& [system, codes] : header_.obs_types) {
     Mapping::System& m = mapping->systems[static_cast<std::size_t>(system_index(system))];
     m.declared = true;
+    m.filtered = filter_ && !filter_->systems.uses(system);
     const std::size_t columns = v3 ? codes.size() : v2_types_.size();
     m.columns.assign(columns, Mapping::Column{});
     for (std::size_t k = 0; k < columns; ++k) {
@@ -540,6 +544,13 @@ void RinexObsReader::build_mapping() {
       const ObsKind kind = kind_from_letter(code[0]);
       const auto signal = core::parse_signal(std::string_view(code).substr(1));
       if (kind == ObsKind::None || !signal) continue;  // e.g. Septentrio's "X1" channel numbers
+      if (filter_) {
+        const auto rank = core::frequency_rank(system, signal->band);
+        if (!rank || *rank > filter_->max_frequency_rank) {
+          m.columns[k].filtered = true;
+          continue;
+        }
+      }
       auto it = std::find(m.signals.begin(), m.signals.end(), *signal);
       if (it == m.signals.end()) it = m.signals.insert(m.signals.end(), *signal);
       double scale = 1.0;
@@ -606,9 +617,9 @@ Result<std::optional<core::SatelliteId>> RinexObsReader::resolve_satellite(std::
   if (text[0] == ' ' && version_code_ < 300) text[0] = 'G';  // RINEX 2: blank means GPS
   const std::string_view id(text, 3);
   if (const auto sat = core::parse_satellite(id)) {
-    if (mapping_->systems[static_cast<std::size_t>(system_index(sat->system))].declared) {
-      return std::optional<core::SatelliteId>(*sat);
-    }
+    const Mapping::System& system = mapping_->systems[static_cast<std::size_t>(system_index(sat->system))];
+    if (system.declared && system.filtered) return std::optional<core::SatelliteId>{};  // not wanted: no warning
+    if (system.declared) return std::optional<core::SatelliteId>(*sat);
     if (warned_systems_.find(text[0]) == std::string::npos) {
       warned_systems_.push_back(text[0]);
       warn(reader_.line_number(), "satellite " + sat->to_string() + ": no observation types declared for " +
@@ -642,6 +653,7 @@ Status RinexObsReader::parse_fields(std::string_view line, std::size_t first_col
   for (std::size_t i = 0; i < count; ++i) {
     const std::size_t pos = first_col + kFieldWidth * i;
     if (pos >= line.size()) break;
+    if (first_field + i < m.columns.size() && m.columns[first_field + i].filtered) continue;
     const std::string_view field = column(line, pos, kValueWidth);
     if (field.size() < kValueWidth && !is_blank(field)) {  // values are right-aligned: the line was cut
       return reader_.error("observation value '" + std::string(trim(field)) + "' cut short in column " +
@@ -903,8 +915,8 @@ Result<std::optional<core::ObsEpoch>> RinexObsReader::next() {
   }
 }
 
-Result<RinexObsFile> read_rinex_obs(const std::string& path) {
-  auto reader = RinexObsReader::open(path);
+Result<RinexObsFile> read_rinex_obs(const std::string& path, std::optional<ObsFilter> filter) {
+  auto reader = RinexObsReader::open(path, filter);
   if (!reader.ok()) return reader.error();
   RinexObsFile file;
   for (;;) {

@@ -6,49 +6,141 @@
 #include <cstdio>
 #include <cstring>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 namespace canyon::io {
 
+// Two sources: a plain regular file is mapped into memory (lines are views into the map: no copy, no read calls);
+// anything else (gzip, a pipe, an empty file) is read through zlib, which reads plain data transparently, into a
+// buffer of whole lines.
 struct TextReader::Impl {
   gzFile file = nullptr;
+  const char* map = nullptr;  // the whole file when mapped
+  std::size_t map_size = 0;
+  long long compressed_offset = 0;  // gzoffset() after the last read, for fraction_read()
   ~Impl() {
     if (file != nullptr) gzclose(file);
+    if (map != nullptr) ::munmap(const_cast<char*>(map), map_size);  // NOLINT(cppcoreguidelines-pro-type-const-cast)
   }
 };
 
 TextReader::TextReader(std::unique_ptr<Impl> impl, std::string path) : impl_(std::move(impl)), path_(std::move(path)) {}
-TextReader::TextReader(TextReader&&) noexcept = default;
-TextReader& TextReader::operator=(TextReader&&) noexcept = default;
+TextReader::TextReader(TextReader&& other) noexcept {
+  *this = std::move(other);
+}
+
+TextReader& TextReader::operator=(TextReader&& other) noexcept {
+  if (this == &other) return *this;
+  // view_ and line_ point into other's buffer_ when it is the source: re-derived from their offsets after the move
+  // (a short string's characters move with the object).
+  const bool buffered = other.impl_ == nullptr || other.impl_->map == nullptr;
+  const std::size_t line_offset =
+      other.line_.empty() ? 0 : static_cast<std::size_t>(other.line_.data() - other.view_.data());
+  const std::size_t line_size = other.line_.size();
+  impl_ = std::move(other.impl_);
+  path_ = std::move(other.path_);
+  buffer_ = std::move(other.buffer_);
+  view_ = buffered ? std::string_view(buffer_) : other.view_;
+  view_pos_ = other.view_pos_;
+  line_ = view_.substr(std::min(line_offset, view_.size()), line_size);
+  pushed_back_ = other.pushed_back_;
+  eof_ = other.eof_;
+  ended_ = other.ended_;
+  line_cut_ = other.line_cut_;
+  line_number_ = other.line_number_;
+  file_size_ = other.file_size_;
+  read_error_ = std::move(other.read_error_);
+  other.view_ = {};
+  other.line_ = {};
+  return *this;
+}
 TextReader::~TextReader() = default;
 
+namespace {
+
+/// The whole of a plain (not gzip) regular file mapped read-only, or nullptr when it cannot be (then zlib reads it).
+const char* map_plain_file(const std::string& path, std::size_t& size) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);  // NOLINT(cppcoreguidelines-pro-type-vararg)
+  if (fd < 0) return nullptr;
+  struct stat info {};
+  const char* map = nullptr;
+  if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size > 2) {
+    size = static_cast<std::size_t>(info.st_size);
+    void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (p != MAP_FAILED) {
+      map = static_cast<const char*>(p);
+      const auto* bytes =
+          reinterpret_cast<const unsigned char*>(map);  // NOLINT(cppcoreguidelines-pro-type-reinterpret-cast)
+      if (bytes[0] == 0x1f && bytes[1] == 0x8b) {       // gzip magic: decompress instead
+        ::munmap(p, size);
+        map = nullptr;
+      } else {
+        ::madvise(p, size, MADV_SEQUENTIAL | MADV_WILLNEED);
+      }
+    }
+  }
+  ::close(fd);
+  return map;
+}
+
+}  // namespace
+
 Result<TextReader> TextReader::open(const std::string& path) {
-  // gzopen reads plain files transparently, so one code path serves both.
   auto impl = std::make_unique<Impl>();
+  std::size_t size = 0;
+  impl->map = map_plain_file(path, size);
+  if (impl->map != nullptr) {
+    impl->map_size = size;
+    TextReader reader(std::move(impl), path);
+    reader.view_ = std::string_view(reader.impl_->map, size);
+    reader.eof_ = true;  // everything is in view_ already
+    reader.file_size_ = size;
+    return reader;
+  }
   impl->file = gzopen(path.c_str(), "rb");
   if (impl->file == nullptr) {
     return Error{std::string("cannot open file: ") + std::strerror(errno), path, 0};
   }
   gzbuffer(impl->file, 1 << 17);
-  return TextReader(std::move(impl), path);
+  TextReader reader(std::move(impl), path);
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && info.st_size > 0) {
+    reader.file_size_ = static_cast<std::uint64_t>(info.st_size);
+  }
+  return reader;
+}
+
+double TextReader::fraction_read() const {
+  if (ended_) return 1.0;
+  if (file_size_ == 0 || impl_ == nullptr) return 0.0;
+  const double done =
+      impl_->map != nullptr ? static_cast<double>(view_pos_) : static_cast<double>(impl_->compressed_offset);
+  return std::clamp(done / static_cast<double>(file_size_), 0.0, 1.0);
 }
 
 bool TextReader::fill() {
   if (eof_) return false;
-  buffer_.erase(0, buffer_pos_);
-  buffer_pos_ = 0;
+  buffer_.erase(0, view_pos_);
+  view_pos_ = 0;
   constexpr std::size_t kChunk = 1 << 16;
   const std::size_t old_size = buffer_.size();
   buffer_.resize(old_size + kChunk);
   const int n = gzread(impl_->file, buffer_.data() + old_size, static_cast<unsigned>(kChunk));
+  impl_->compressed_offset = gzoffset(impl_->file);
   if (n < 0) {
     int code = 0;
     read_error_ = std::string("read error: ") + gzerror(impl_->file, &code);
     buffer_.resize(old_size);
+    view_ = buffer_;
     eof_ = true;
     return false;
   }
   buffer_.resize(old_size + static_cast<std::size_t>(n));
+  view_ = buffer_;
   if (n == 0) {
     eof_ = true;
     // A gzip stream cut short reads as a clean end in zlib; gzerror tells the difference.
@@ -68,29 +160,29 @@ std::optional<std::string_view> TextReader::next_line() {
   if (pushed_back_) {
     pushed_back_ = false;
     ++line_number_;
-    return std::string_view(line_);
+    return line_;
   }
   for (;;) {
-    const std::size_t newline = buffer_.find('\n', buffer_pos_);
-    if (newline != std::string::npos) {
-      line_.assign(buffer_, buffer_pos_, newline - buffer_pos_);
-      buffer_pos_ = newline + 1;
+    const std::size_t newline = view_.find('\n', view_pos_);
+    if (newline != std::string_view::npos) {
+      line_ = view_.substr(view_pos_, newline - view_pos_);
+      view_pos_ = newline + 1;
       break;
     }
     if (!fill()) {
-      if (buffer_pos_ >= buffer_.size()) {
+      if (view_pos_ >= view_.size()) {
         ended_ = true;
         return std::nullopt;
       }
-      line_.assign(buffer_, buffer_pos_, std::string::npos);  // last line without a newline
-      buffer_pos_ = buffer_.size();
+      line_ = view_.substr(view_pos_);  // last line without a newline
+      view_pos_ = view_.size();
       line_cut_ = read_error_.has_value();
       break;
     }
   }
-  if (!line_.empty() && line_.back() == '\r') line_.pop_back();
+  if (!line_.empty() && line_.back() == '\r') line_.remove_suffix(1);
   ++line_number_;
-  return std::string_view(line_);
+  return line_;
 }
 
 void TextReader::unread_line() {

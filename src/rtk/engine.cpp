@@ -19,9 +19,8 @@ namespace {
 using core::Constellation;
 using core::SatelliteId;
 
-constexpr double kMaxBaseTimeAheadS = 0.05;
-constexpr std::size_t kPrunedSubsets = 3;  // partial fixing prunes at most this many group-excluded subsets  // base
-                                           // tags up to this much after the rover tag still count as "now"
+constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
+constexpr std::size_t kPrunedSubsets = 3;    // partial fixing prunes at most this many group-excluded subsets
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {
@@ -361,8 +360,8 @@ std::string RtkOptions::validate() const {
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
   if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";
-  if (!(max_post_fit_sigmas > 0.0) || max_post_fit_rejections < 0) {
-    return "max_post_fit_sigmas must be > 0 and max_post_fit_rejections >= 0";
+  if (!(max_post_fit_sigmas > 0.0) || !(max_post_fit_code_sigmas > 0.0) || max_post_fit_rejections < 0) {
+    return "max_post_fit_sigmas and max_post_fit_code_sigmas must be > 0 and max_post_fit_rejections >= 0";
   }
   if (const std::string e = slips.validate(); !e.empty()) return "slips: " + e;
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
@@ -563,9 +562,9 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
 }
 
 int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected) {
-  // Update, then check the post-fit phase residuals: a signal whose residual is beyond the threshold (a phase
-  // inconsistent with the others, e.g. an undetected slip or signals two receivers track differently) is dropped for
-  // this epoch and the update redone from the prior.
+  // Update, then check the post-fit residuals: a signal whose residual is beyond the threshold (a phase inconsistent
+  // with the others, e.g. an undetected slip or signals two receivers track differently; a code far off, e.g. a
+  // reflection) is dropped for this epoch and the update redone from the prior.
   const Eigen::VectorXd x0 = x_;
   const Eigen::MatrixXd P0 = P_;
   int used = 0;
@@ -573,14 +572,17 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
     PostFit post_fit;
     used = update_once(sds, rejected, post_fit);
     last_post_fit_normalised_ = post_fit.worst_normalised;
-    if (post_fit.worst_sd < 0 || post_fit.worst_normalised <= options_.max_post_fit_sigmas ||
-        attempt == options_.max_post_fit_rejections) {
+    if (post_fit.worst_sd < 0 || post_fit.worst_normalised <= 1.0 || attempt == options_.max_post_fit_rejections) {
       break;
     }
     SingleDiff& bad = sds[static_cast<std::size_t>(post_fit.worst_sd)];
     rejected.push_back(bad.sat);
-    bad.ambiguity = -1;  // its phase is not used (nor fixed) this epoch
-    bad.fixable = false;
+    if (post_fit.worst_is_code) {
+      bad.code_m = core::kNoValue;  // its code is not used this epoch
+    } else {
+      bad.ambiguity = -1;  // its phase is not used (nor fixed) this epoch
+      bad.fixable = false;
+    }
     x_ = x0;
     P_ = P0;
   }
@@ -694,15 +696,22 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
   U << code_step.U, phase_step.U;
   V << code_step.V, phase_step.V;
   subtract_symmetric_product(P_, U, V);
-  // Post-fit DD phase residuals, normalised by their measurement sigma: the worst one is reported.
+  // Post-fit DD residuals, normalised by their measurement sigma and by the threshold of their kind (phase or code):
+  // the worst one is reported, beyond its threshold when the normalised value exceeds 1.
   post_fit = PostFit{};
-  for (const DdRow* row : phase_rows) {
-    const double normalised = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
-    if (normalised > post_fit.worst_normalised) {
-      post_fit.worst_normalised = normalised;
-      post_fit.worst_sd = row->sd;
+  const auto check = [&](const std::vector<const DdRow*>& block, double threshold_sigmas, bool code) {
+    for (const DdRow* row : block) {
+      const double sigmas = std::abs(row->innovation_m - row->dot(dx)) / std::sqrt(covariance(*row, *row));
+      const double normalised = sigmas / threshold_sigmas;
+      if (normalised > post_fit.worst_normalised) {
+        post_fit.worst_normalised = normalised;
+        post_fit.worst_sd = row->sd;
+        post_fit.worst_is_code = code;
+      }
     }
-  }
+  };
+  check(phase_rows, options_.max_post_fit_sigmas, false);
+  check(code_rows, options_.max_post_fit_code_sigmas, true);
   last_code_rows_ = static_cast<int>(code_rows.size());
   return static_cast<int>(phase_rows.size());
 }
@@ -922,21 +931,39 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
     out.note = "too few ambiguities to fix: " + std::to_string(all.size());
     return false;
   }
-  std::optional<Fix> best = try_fix(all, options_.min_fix_ambiguities);
-  if (best) out.solution.ratio = std::min(best->ratio, 999.9);
-  if (!best || !accepted(*best)) {
-    const std::string why = !best                                    ? "integer search failed"
-                            : best->ratio < options_.ratio_threshold ? "ratio test failed"
-                                                                     : "success rate too low";
-    // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the
-    // float ambiguities left out, which are biased when the full set fails.
-    const auto min_size = static_cast<int>(std::ceil(options_.min_partial_fraction * static_cast<double>(all.size())));
-    best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
-    if (!best) {
-      out.note = why;
-      return false;
-    }
+  // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the
+  // float ambiguities left out, which are biased when the full set fails.
+  const auto min_size = static_cast<int>(std::ceil(options_.min_partial_fraction * static_cast<double>(all.size())));
+  std::vector<DdKey> all_keys;
+  all_keys.reserve(all.size());
+  for (const auto& pair : all) all_keys.push_back(dd_key(pair));
+  // The same full set failed at the last epoch and a subset was fixed: the subset is tried first, and the full set
+  // again only every kFullSetRetryEpochs epochs (or when the set changes). One epoch more of data seldom turns a
+  // failing set around, and each integer search of the full set costs as much as the rest of the epoch.
+  std::optional<Fix> best;
+  if (options_.partial_ar && all_keys == failed_full_set_ && epochs_since_full_set_ < kFullSetRetryEpochs) {
+    best = last_subset_fix(all, min_size);
+    ++epochs_since_full_set_;
+  }
+  if (best) {
     out.solution.ratio = std::min(best->ratio, 999.9);
+  } else {
+    best = try_fix(all, options_.min_fix_ambiguities);
+    epochs_since_full_set_ = 0;
+    failed_full_set_.clear();
+    if (best) out.solution.ratio = std::min(best->ratio, 999.9);
+    if (!best || !accepted(*best)) {
+      failed_full_set_ = all_keys;
+      const std::string why = !best                                    ? "integer search failed"
+                              : best->ratio < options_.ratio_threshold ? "ratio test failed"
+                                                                       : "success rate too low";
+      best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size) : std::nullopt;
+      if (!best) {
+        out.note = why;
+        return false;
+      }
+      out.solution.ratio = std::min(best->ratio, 999.9);
+    }
   }
   // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix).
   const Eigen::LLT<Eigen::MatrixXd> llt(best->Q_a);
@@ -944,10 +971,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
     out.note = "float ambiguity covariance not positive definite";
     return false;
   }
-  const Eigen::VectorXd x_fix = x_ - best->PDt * llt.solve(best->a_float - best->a_fix);
-  const Eigen::MatrixXd P_fix = P_ - best->PDt * llt.solve(best->PDt.transpose());
-  out.solution.p_E_m = x_fix.head<3>();
-  out.solution.P_E_m2 = P_fix.topLeftCorner<3, 3>();
+  // Only the position block is output: its rows of P D^T suffice (the whole x_fix, P_fix would cost n^2 nd).
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = best->PDt.topRows<3>();
+  out.solution.p_E_m = x_.head<3>() - PDt_p * llt.solve(best->a_float - best->a_fix);
+  out.solution.P_E_m2 = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
   out.solution.status = core::SolutionStatus::Fixed;
   out.num_fixed_ambiguities = static_cast<int>(best->a_fix.size());
   out.ar_pruned = best->pruned;

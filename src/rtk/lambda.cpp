@@ -231,8 +231,9 @@ void swap_neighbours(const ReductionView& v, Eigen::Index k, double delta) {
 }
 
 /// Reduction (decorrelation) of an already factorised problem: the swaps of MLAMBDA's reduction, with only the
-/// sub-diagonal entry size-reduced before each swap test and one size-reduction pass at the end (see the contract).
-Status reduce(const ReductionView& v) {
+/// sub-diagonal entry size-reduced before each swap test and, when `size_reduce_all`, one size-reduction pass at the
+/// end (see the contract).
+Status reduce(const ReductionView& v, bool size_reduce_all) {
   const Eigen::Index n = v.n;
   Eigen::Index k = n - 2;
   std::int64_t steps = 0;
@@ -256,6 +257,7 @@ Status reduce(const ReductionView& v) {
       --k;
     }
   }
+  if (!size_reduce_all) return Ok{};
   // Size reduction: |L_ik| <= 1/2 for all i > k. Column k is reduced from the top (i = k + 1 first): G_ik changes
   // only rows >= i of column k, which are reduced afterwards; d and the columns > k are untouched.
   for (Eigen::Index col = n - 2; col >= 0; --col) {
@@ -266,9 +268,10 @@ Status reduce(const ReductionView& v) {
 
 /// Factorisation and reduction into dec. With log == nullptr, dec.Z_inv receives Z^{-T}; otherwise dec.Z_inv is
 /// left empty and the operations are logged (with the initial permutation) for back_transform(). dec.Z is left empty
-/// unless with_z. z_hat (with a_centred and perm) receives Z^T a_centred.
-Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool with_z, Eigen::VectorXd* z_hat,
-                        const Eigen::VectorXd* a_centred, std::vector<Eigen::Index>* perm,
+/// unless with_z. z_hat (with a_centred and perm) receives Z^T a_centred. Without `size_reduce_all` the final
+/// size-reduction pass is skipped (for the search: it cannot change which nodes the search visits).
+Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool size_reduce_all, bool with_z,
+                        Eigen::VectorXd* z_hat, const Eigen::VectorXd* a_centred, std::vector<Eigen::Index>* perm,
                         std::vector<ElementaryOperation>* log) {
   assert(z_hat == nullptr || (a_centred != nullptr && perm != nullptr));
   const Eigen::Index n = Q_a.rows();
@@ -287,7 +290,7 @@ Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool wit
     for (Eigen::Index i = 0; i < n; ++i) (*z_hat)[i] = (*a_centred)[(*perm)[static_cast<std::size_t>(i)]];
     v.z_hat = z_hat->data();
   }
-  return reduce(v);
+  return reduce(v, size_reduce_all);
 }
 
 double sign_toward(double y) {
@@ -420,7 +423,7 @@ Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a) {
   if (!Q_a.allFinite()) return Error("decorrelate: Q_a has a non-finite entry");
   if (auto s = check_symmetric(Q_a, "decorrelate"); !s) return s.error();
   Decorrelation dec;
-  if (auto s = decorrelate_into(Q_a, dec, true, nullptr, nullptr, nullptr, nullptr); !s) return s.error();
+  if (auto s = decorrelate_into(Q_a, dec, true, true, nullptr, nullptr, nullptr, nullptr); !s) return s.error();
   dec.Z_inv.transposeInPlace();
   return dec;
 }
@@ -439,7 +442,8 @@ Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen:
   std::vector<Eigen::Index> perm;
   std::vector<ElementaryOperation> log;
   log.reserve(1024);
-  if (auto s = decorrelate_into(Q_a, dec, options.with_z, &z_hat, &a_centred, &perm, &log); !s) return s.error();
+  if (auto s = decorrelate_into(Q_a, dec, options.with_z, options.with_z, &z_hat, &a_centred, &perm, &log); !s)
+    return s.error();
 
   IntegerSearchResult out;
   auto found = search(dec, z_hat, options.num_candidates, options.max_search_nodes, out.search_nodes);

@@ -99,7 +99,12 @@ std::map<std::string, int> satellites_per_epoch(const fs::path& pos, std::string
     double h = 0;
     int q = 0;
     int ns = 0;
-    if (fields >> week >> tow >> lat >> lon >> h >> q >> ns) out[week + " " + tow] = ns;
+    if (fields >> week >> tow >> lat >> lon >> h >> q >> ns) {
+      std::string key = week;
+      key += ' ';
+      key += tow;
+      out[key] = ns;
+    }
   }
   return out;
 }

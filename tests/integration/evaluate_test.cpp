@@ -53,7 +53,7 @@ Eigen::Vector3d truth_at(int k) {
 
 /// canyon's truth.csv: 10 epochs at 1 Hz.
 fs::path write_truth(const fs::path& dir) {
-  const fs::path path = dir / "truth.csv";
+  fs::path path = dir / "truth.csv";
   std::ofstream out(path);
   out << "gps_week,gps_tow_s,x,y,z,qx,qy,qz,qw\n";
   for (int k = 0; k < 10; ++k) {
@@ -92,7 +92,7 @@ const Injected kInjected[10] = {{2, {0, 0, 0.5}},   {1, {0.02, 0, 0}}, {1, {0, 0
 
 /// RTKLIB's exact layout with out-timesys=utc, out-timeform=hms, out-degform=dms.
 fs::path write_rtklib_pos(const fs::path& dir) {
-  const fs::path path = dir / "rtklib_injected.pos";
+  fs::path path = dir / "rtklib_injected.pos";
   std::ofstream out(path);
   out << "% program   : RTKLIB ver.2.4.3\n% inp file  : rover.obs\n% pos mode  : Kinematic\n%\n"
          "% (lat/lon/height=WGS84/ellipsoidal,Q=1:fix,2:float,3:sbas,4:dgps,5:single,6:ppp,ns=# of satellites)\n"
@@ -177,7 +177,7 @@ TEST(EvaluateCli, EveryRtklibOutputFormReadsToTheSamePositions) {
     std::ofstream(extra) << read_text(conf);
     std::ofstream(extra, std::ios::app) << "\n";
     for (const std::string& o : options) std::ofstream(extra, std::ios::app) << o << "\n";
-    const fs::path pos = dir / (name + ".pos");
+    fs::path pos = dir / (name + ".pos");
     const auto r = test::run_command("cd " + data.string() + " && rnx2rtkp -k " + extra.string() + " -o " +
                                      pos.string() + " SEPT078M1.21O 3034078M1.21O SEPT078M.21P");
     EXPECT_EQ(r.exit_code, 0) << r.output;

@@ -199,11 +199,46 @@ TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
               << ", max distance " << agreement->max_distance_fixed_m << " m\n";
     EXPECT_GE(ours->fixed().epochs, theirs->fixed().epochs);
     EXPECT_GE(agreement->both_fixed, theirs->fixed().epochs * 9 / 10);
-    // Issue 3 asks for 3 cm. Continuous mode: at epochs 282705 and 282769 canyon is 6.4 cm from RTKLIB (in height)
-    // because it drops G14 there: its phases jump by 9 cm on both frequencies (non-dispersive) the epoch before the
-    // satellite is lost, and the post-fit test rejects them; RTKLIB keeps them. Bounded here so that a regression
-    // still fails. Instantaneous mode meets the 3 cm.
-    EXPECT_LE(agreement->max_distance_fixed_m, k.mode == rtk::ArMode::Continuous ? 0.07 : kMaxDistanceToRtklibFixM);
+    // Within 3 cm of RTKLIB on every epoch both fixed, but where RTKLIB's fix rests on a satellite canyon rejects: at
+    // 282769 (continuous) G14's phases jump by 9 cm on both frequencies (non-dispersive) before the satellite is
+    // lost; canyon's post-fit test drops it, RTKLIB keeps it and is 6.3 cm off in height. There RTKLIB itself, run
+    // with G14 excluded, must agree with canyon within 3 cm: the difference is G14's, not canyon's.
+    std::vector<core::GpsTime> beyond;
+    for (const core::Solution& c : run->solutions) {
+      const core::Solution* r = test::nearest(*rtklib, c.time, 0.01);
+      if (c.status == core::SolutionStatus::Fixed && r != nullptr && r->status == core::SolutionStatus::Fixed &&
+          (c.p_E_m - r->p_E_m).norm() > kMaxDistanceToRtklibFixM) {
+        beyond.push_back(c.time);
+      }
+    }
+    EXPECT_LE(beyond.size(), 2U);
+    if (beyond.empty() || !test::have_rtklib()) continue;
+    const fs::path dir = test::temp_dir("rtk") / "kinematic-without-g14";
+    fs::create_directories(dir);
+    const fs::path conf = dir / "rtklib.conf";
+    {
+      std::ifstream in(shared_data() / "cssrlib-kinematic-doy265/rtklib" /
+                       (k.mode == rtk::ArMode::Continuous ? "rtk_kinematic.conf" : "rtk_kinematic_inst.conf"));
+      std::ofstream out(conf);
+      for (std::string line; std::getline(in, line);)
+        out << (line.rfind("pos1-exclsats", 0) == 0 ? "pos1-exclsats =G14" : line) << "\n";
+    }
+    const fs::path data = shared_data() / "cssrlib-kinematic-doy265";
+    const auto r = test::run_command("rnx2rtkp -k " + conf.string() + " -o " + (dir / "rtklib.pos").string() + " " +
+                                     (data / "SEPT265G.21O").string() + " " + (data / "3034265G.21O").string() + " " +
+                                     (data / "SEPT2650.21P").string() + " 2>/dev/null");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    auto without_g14 = io::read_pos_file((dir / "rtklib.pos").string());
+    ASSERT_TRUE(without_g14.ok());
+    for (const core::GpsTime& t : beyond) {
+      const core::Solution* c = test::nearest(run->solutions, t, 0.01);
+      const core::Solution* r14 = test::nearest(*without_g14, t, 0.01);
+      ASSERT_TRUE(c != nullptr && r14 != nullptr);
+      EXPECT_LE((c->p_E_m - r14->p_E_m).norm(), kMaxDistanceToRtklibFixM) << "tow " << t.tow_s;
+      std::cout << "[ RTK      ] tow " << t.tow_s << ": canyon - RTKLIB "
+                << (c->p_E_m - test::nearest(*rtklib, t, 0.01)->p_E_m).norm() << " m, canyon - RTKLIB without G14 "
+                << (c->p_E_m - r14->p_E_m).norm() << " m\n";
+    }
   }
 }
 
@@ -224,11 +259,12 @@ TEST(RtkRealData, CssrlibKinematicWithQzssAndOnL1Alone) {
     const char* rtklib_pos;  // RTKLIB's run in the same configuration, nullptr if none
     double min_fixed_fraction;
   };
-  // With QZSS canyon keeps its own GPS + Galileo fix rate (100 % in both modes) within 1 %: measured 100 % and
-  // 99.2 %, against RTKLIB's drop from 22.8 % to 12.8 % and from 90.8 % to 65.0 %.
+  // With QZSS canyon keeps its own GPS + Galileo fix rate (100 % in both modes), against RTKLIB's drop from 22.8 % to
+  // 12.8 % and from 90.8 % to 65.0 % (QZS-3's L1 code is 44 m off the others at some epochs: the post-fit code test
+  // drops it).
   for (const Case& k :
-       {Case{"continuous+J", rtk::ArMode::Continuous, true, 2, "rtk_kinematic_withqzss.pos", 0.99},
-        Case{"instantaneous+J", rtk::ArMode::Instantaneous, true, 2, "rtk_kinematic_inst_withqzss.pos", 0.99},
+       {Case{"continuous+J", rtk::ArMode::Continuous, true, 2, "rtk_kinematic_withqzss.pos", 1.0},
+        Case{"instantaneous+J", rtk::ArMode::Instantaneous, true, 2, "rtk_kinematic_inst_withqzss.pos", 1.0},
         Case{"continuous L1", rtk::ArMode::Continuous, false, 1, nullptr, 0.9},
         Case{"instantaneous L1", rtk::ArMode::Instantaneous, false, 1, nullptr, 0.0}}) {
     auto run = run_rtk("kinematic", "cssrlib-kinematic-doy265/SEPT265G.21O", "cssrlib-kinematic-doy265/3034265G.21O",
@@ -255,6 +291,39 @@ TEST(RtkRealData, CssrlibKinematicWithQzssAndOnL1Alone) {
       EXPECT_GE(ours->fixed().epochs, theirs->fixed().epochs) << k.name;
     }
   }
+}
+
+/// m8p-galway-20181004 (u-blox M8P, L1 only, GPS + GLONASS with GLONASS AR off, a base logged with gaps of up to
+/// 39 s): fix rate at least RTKLIB's (39 of 1180 epochs, the run shipped with the dataset), and fixed positions within
+/// 10 cm of RTKLIB's where both are fixed. There is no truth; both programs fix in short, mostly disjoint runs.
+TEST(RtkRealData, M8pSingleFrequencyFixRateAtLeastRtklibs) {
+  REQUIRE_DATA("m8p-galway-20181004");
+  const std::string dir = "m8p-galway-20181004/rinex/";
+  auto base_header = io::RinexObsReader::open((shared_data() / dir / "20181004_base-20181004-1452.obs").string());
+  ASSERT_TRUE(base_header.ok());
+  ASSERT_TRUE(base_header->header().receiver.approx_position_E_m.has_value());
+  auto run = run_rtk("m8p", dir + "20181004_rover-20181004-1532.obs", dir + "20181004_base-20181004-1452.obs",
+                     {dir + "20181004_base-20181004-1452.nav"}, *base_header->header().receiver.approx_position_E_m,
+                     [](app::ProcessConfig& c) {
+                       c.rtk.observables.num_frequencies = 1;
+                       c.rtk.observables.use_galileo = c.rtk.observables.use_beidou = false;
+                       c.rtk.observables.use_qzss = false;  // RTKLIB's run: navsys 5 (GPS + GLONASS)
+                       c.rtk.glonass_ar = false;
+                     });
+  ASSERT_TRUE(run.has_value());
+  auto rtklib =
+      io::read_pos_file((shared_data() / "m8p-galway-20181004/rtklib/20181004_run2_rtk_kinematic.pos").string());
+  ASSERT_TRUE(rtklib.ok());
+  auto ours = eval::evaluate(run->solutions, nullptr);
+  auto theirs = eval::evaluate(*rtklib, nullptr);
+  auto agreement = eval::compare(run->solutions, *rtklib);
+  ASSERT_TRUE(ours.ok() && theirs.ok() && agreement.ok());
+  std::cout << "[ RTK      ] m8p: canyon " << ours->fixed().epochs << " fixed, RTKLIB " << theirs->fixed().epochs
+            << "; both fixed " << agreement->both_fixed << ", max distance " << agreement->max_distance_fixed_m
+            << " m\n";
+  EXPECT_EQ(run->summary.epochs, 1180);
+  EXPECT_GE(ours->fixed().epochs, theirs->fixed().epochs);
+  EXPECT_LE(agreement->max_distance_fixed_m, kWrongFixM);
 }
 
 TEST(RtkBadInput, MissingBasePositionAndBaseFromAnotherDay) {

@@ -24,7 +24,7 @@ constexpr double kMaxTimeDiffS = 1e-6;
 fs::path write_file(const std::string& name, const std::string& text) {
   const fs::path dir = fs::temp_directory_path() / "canyon_pos_formats";
   fs::create_directories(dir);
-  const fs::path path = dir / name;
+  fs::path path = dir / name;
   std::ofstream(path) << text;
   return path;
 }

@@ -412,5 +412,62 @@ TEST(RinexObservationSharedData, RoundTripEveryOtherFile) {
   for (const std::string& path : observation_files()) expect_round_trip(path);
 }
 
+/// What a filter should keep of an unfiltered read: the same epochs, with only the kept systems and signals.
+RinexObsFile expected_after_filter(RinexObsFile file, const ObsFilter& filter) {
+  for (core::ObsEpoch& epoch : file.epochs) {
+    std::erase_if(epoch.sats, [&](const core::SatelliteObs& s) { return !filter.systems.uses(s.sat.system); });
+    for (core::SatelliteObs& sat : epoch.sats) {
+      std::erase_if(sat.signals, [&](const core::SignalObs& s) {
+        const auto rank = core::frequency_rank(sat.sat.system, s.code.band);
+        return !rank || *rank > filter.max_frequency_rank;
+      });
+    }
+  }
+  return file;
+}
+
+TEST(RinexObservationSharedData, FilteredReadKeepsExactlyTheSystemsAndFrequenciesAsked) {
+  SKIP_WITHOUT_SHARED_DATA();
+  // GPS + Galileo + QZSS, three frequencies, Galileo E5a and E5 AltBOC: QZSS and ranks > 0 or > 1 left out.
+  const std::string path = kData + "/cssrlib-kinematic-doy265/SEPT265G.21O";
+  const RinexObsFile all = read_ok(path);
+  for (const int max_rank : {0, 1}) {
+    ObsFilter filter;
+    filter.systems.use_glonass = false;
+    filter.systems.use_beidou = false;
+    filter.systems.use_qzss = false;
+    filter.max_frequency_rank = max_rank;
+    auto filtered = read_rinex_obs(path, filter);
+    ASSERT_TRUE(filtered.ok()) << filtered.error().to_string();
+    const RinexObsFile expected = expected_after_filter(all, filter);
+    ASSERT_EQ(filtered->epochs.size(), expected.epochs.size());
+    std::size_t signals = 0;
+    for (std::size_t e = 0; e < expected.epochs.size(); ++e) {
+      const auto& got = filtered->epochs[e];
+      const auto& want = expected.epochs[e];
+      ASSERT_EQ(got.time, want.time);
+      ASSERT_EQ(got.sats.size(), want.sats.size()) << "epoch " << e;
+      for (std::size_t k = 0; k < want.sats.size(); ++k) {
+        ASSERT_EQ(got.sats[k].sat, want.sats[k].sat);
+        ASSERT_EQ(got.sats[k].signals.size(), want.sats[k].signals.size()) << want.sats[k].sat.to_string();
+        for (std::size_t j = 0; j < want.sats[k].signals.size(); ++j) {
+          const core::SignalObs& g = got.sats[k].signals[j];
+          const core::SignalObs& w = want.sats[k].signals[j];
+          EXPECT_EQ(g.code, w.code);
+          EXPECT_TRUE(g.pseudorange_m == w.pseudorange_m ||
+                      (std::isnan(g.pseudorange_m) && std::isnan(w.pseudorange_m)));
+          EXPECT_TRUE(g.carrier_phase_cyc == w.carrier_phase_cyc ||
+                      (std::isnan(g.carrier_phase_cyc) && std::isnan(w.carrier_phase_cyc)));
+          EXPECT_EQ(g.lli, w.lli);
+          ++signals;
+        }
+      }
+    }
+    EXPECT_GT(signals, 0U);
+    // No warnings for what the filter leaves out (QZSS is declared in the header, so the unfiltered read has none).
+    EXPECT_EQ(filtered->warnings.size(), all.warnings.size());
+  }
+}
+
 }  // namespace
 }  // namespace canyon::io

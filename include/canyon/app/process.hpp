@@ -33,8 +33,9 @@ struct ProcessSummary {
 [[nodiscard]] std::vector<core::SatelliteId> most_observed_satellites(const std::vector<core::ObsEpoch>& epochs, int n,
                                                                       const core::ConstellationFlags& systems);
 
-/// Called after each epoch with (epochs done, epochs in total).
-using ProgressFn = std::function<void(int, int)>;
+/// Called after each epoch with (rover epochs done, fraction of the rover file read 0..1). Observation files are
+/// read epoch by epoch, so the number of epochs is not known before the end.
+using ProgressFn = std::function<void(int, double)>;
 
 /// Runs the configured mode over the whole input. Error (file and line) if an input cannot be read or the output
 /// cannot be written; an epoch that cannot be solved is counted and skipped.

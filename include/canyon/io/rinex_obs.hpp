@@ -30,6 +30,7 @@
 
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
+#include "canyon/core/satellite.hpp"
 #include "canyon/io/text_reader.hpp"
 
 namespace canyon::io {
@@ -49,10 +50,19 @@ struct RinexObsHeader {
   std::string program_date;
 };
 
+/// Which observations a reader keeps: constellations, and signals up to a frequency rank (core::frequency_rank; 0:
+/// L1/E1/B1I/G1 only ... 2: all three). Records and fields left out are skipped without being parsed, so a
+/// defect in them is not noticed either; a program that uses only some signals reads faster.
+struct ObsFilter {
+  core::ConstellationFlags systems;  ///< constellations kept
+  int max_frequency_rank = 2;        ///< signals of a higher frequency rank (or of no known rank) are skipped
+};
+
 class RinexObsReader {
  public:
   /// Opens the file and reads the header. Error (file and line) on unreadable, unsupported or malformed header.
-  static Result<RinexObsReader> open(const std::string& path);
+  /// Every observation is kept unless `filter` says otherwise.
+  static Result<RinexObsReader> open(const std::string& path, std::optional<ObsFilter> filter = std::nullopt);
 
   [[nodiscard]] const RinexObsHeader& header() const { return header_; }
 
@@ -93,6 +103,9 @@ class RinexObsReader {
   /// than the longest real epoch (RINEX 2: up to 4 lines per satellite, 100+ satellites), so one corrupt first
   /// epoch is still skipped and read past.
   static constexpr int kMaxLinesBeforeFirstEpoch = 1000;
+
+  /// Fraction of the file read so far (0..1), for progress reports.
+  [[nodiscard]] double fraction_read() const { return reader_.fraction_read(); }
 
   /// Warnings about recovered defects so far, "file:line: what" each.
   [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
@@ -168,6 +181,7 @@ class RinexObsReader {
     double factor = 1.0;
   };
   std::vector<ScaleFactor> scale_factors_;  // "SYS / SCALE FACTOR"
+  std::optional<ObsFilter> filter_;         // observations kept (all when empty)
   ScaleFactor continued_scale_;             // system and factor a continuation line refers to
   // Body state for recovery.
   int header_end_line_ = 0;                 // line of END OF HEADER
@@ -186,8 +200,9 @@ struct RinexObsFile {
   std::vector<core::ObsEpoch> epochs;
   std::vector<std::string> warnings;
 };
-/// Every epoch of the file and the reader's warnings; an Error when open() or next() gives one.
-Result<RinexObsFile> read_rinex_obs(const std::string& path);
+/// Every epoch of the file and the reader's warnings; an Error when open() or next() gives one. With a filter, only
+/// the observations it keeps (see ObsFilter).
+Result<RinexObsFile> read_rinex_obs(const std::string& path, std::optional<ObsFilter> filter = std::nullopt);
 
 /// Writes RINEX 3.04 observations. Observation types per system are taken from `header.obs_types` if given,
 /// else collected from the epochs. Error if the file cannot be written.

@@ -21,7 +21,8 @@ class TextReader {
   ~TextReader();
 
   /// Next line without its end-of-line characters (LF or CRLF); nullopt at end of file. A read error
-  /// (e.g. a truncated gzip stream) is reported by error() after next_line() returns nullopt.
+  /// (e.g. a truncated gzip stream) is reported by error() after next_line() returns nullopt. The view is valid until
+  /// the next call.
   std::optional<std::string_view> next_line();
   /// Pushes the last line back so the next call to next_line() returns it again (one line only).
   void unread_line();
@@ -35,6 +36,9 @@ class TextReader {
   /// Whether the last line consumed (returned and not pushed back) is the unterminated tail that a read error left
   /// behind: a line cut short, e.g. by a truncated gzip stream.
   [[nodiscard]] bool line_cut() const { return line_cut_ && !pushed_back_; }
+  /// Fraction of the file read so far, 0..1 (of the compressed size for gzip); 0 if the size is unknown. For
+  /// progress reports: it moves in steps of the read buffer.
+  [[nodiscard]] double fraction_read() const;
   /// Error at the current line.
   [[nodiscard]] Error error(std::string message) const { return Error{std::move(message), path_, line_number_}; }
 
@@ -45,14 +49,16 @@ class TextReader {
 
   std::unique_ptr<Impl> impl_;
   std::string path_;
-  std::string buffer_;
-  std::size_t buffer_pos_ = 0;
-  std::string line_;
+  std::string buffer_;        // read buffer (zlib source)
+  std::string_view view_;     // the text: the mapped file, or buffer_
+  std::size_t view_pos_ = 0;  // start of the next line in view_
+  std::string_view line_;     // the last line returned (into view_)
   bool pushed_back_ = false;
   bool eof_ = false;
   bool ended_ = false;
   bool line_cut_ = false;
   int line_number_ = 0;
+  std::uint64_t file_size_ = 0;  // bytes on disk, 0 if unknown
   std::optional<std::string> read_error_;
 };
 

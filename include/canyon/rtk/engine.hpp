@@ -21,8 +21,10 @@
 // The DD covariance follows from the SD variances (correlated through the reference satellite).
 //
 // Outliers: DD innovations beyond max_phase_innovation_m / max_code_innovation_m are not used; after the update,
-// a DD phase whose post-fit residual exceeds max_post_fit_sigmas is dropped for the epoch and the update redone from
-// the prior (at most max_post_fit_rejections times).
+// the DD phase or code whose post-fit residual exceeds its threshold (max_post_fit_sigmas for phase,
+// max_post_fit_code_sigmas for code, in measurement sigmas) by the largest factor is dropped for the epoch and the
+// update redone from the prior (at most max_post_fit_rejections times). A code outlier (an NLOS signal, a code of
+// another tracking mode) pulls the float position and with it every ambiguity; rejecting it keeps the float fixable.
 //
 // Cycle slips: each receiver's phases go through a CycleSlipDetector (loss of lock, half-cycle changes,
 // geometry-free jumps, Doppler against phase, outages); a slip at either receiver re-initialises the SD ambiguity,
@@ -103,7 +105,8 @@ struct RtkOptions {
   double max_phase_innovation_m = 30.0;       ///< DD phase innovations beyond are rejected as outliers
   double max_code_innovation_m = 100.0;       ///< DD code innovations beyond are rejected as outliers
   double max_post_fit_sigmas = 4.0;           ///< DD phase post-fit residuals beyond (in sigmas) are rejected
-  int max_post_fit_rejections = 3;            ///< at most this many signals rejected per epoch
+  double max_post_fit_code_sigmas = 6.0;      ///< DD code post-fit residuals beyond (in sigmas) are rejected
+  int max_post_fit_rejections = 3;            ///< at most this many signals (phase or code) rejected per epoch
   double hold_sigma_cyc = 0.001;              ///< fix-and-hold pseudo-measurement sigma (cycles)
   double max_outage_s = 5.0;                  ///< an ambiguity not observed for longer is re-initialised
   CycleSlipOptions slips;                     ///< cycle-slip detection at each receiver
@@ -141,7 +144,8 @@ struct RtkEpoch {
   // The float solution and the post-fit check of the update (also when a fix is output).
   Eigen::Vector3d float_p_E_m = Eigen::Vector3d::Zero();
   Eigen::Matrix3d float_P_E_m2 = Eigen::Matrix3d::Zero();
-  double max_post_fit_normalised = 0.0;      ///< largest |DD phase post-fit residual| / sigma after rejections
+  double max_post_fit_normalised = 0.0;      ///< largest DD post-fit residual (phase or code) over its rejection
+                                             ///< threshold (max_post_fit_sigmas or _code_sigmas) after rejections
   std::vector<core::SatelliteId> ar_pruned;  ///< satellites partial fixing pruned by their ILS residual
   // Aided epochs: the prior (after the time update with the aiding).
   bool aided = false;
@@ -198,8 +202,9 @@ class RtkEngine {
   /// EKF update with the DD code and phase, with post-fit rejection; returns the number of DD phase rows used.
   int measurement_update(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected);
   struct PostFit {
-    int worst_sd = -1;              // SD of the largest normalised post-fit phase residual
-    double worst_normalised = 0.0;  // |residual| / measurement sigma
+    int worst_sd = -1;              // SD of the largest normalised post-fit residual
+    double worst_normalised = 0.0;  // |residual| / (measurement sigma * threshold of its kind): beyond when > 1
+    bool worst_is_code = false;     // the worst residual is a code one
   };
   int update_once(std::vector<SingleDiff>& sds, std::vector<core::SatelliteId>& rejected, PostFit& post_fit);
   /// A candidate fix of a set of DD ambiguities (state index of s, of its reference).
@@ -271,6 +276,9 @@ class RtkEngine {
   std::map<DdKey, double> prior_last_fix_;
   double last_post_fit_normalised_ = 0.0;
   int last_code_rows_ = 0;
+  static constexpr int kFullSetRetryEpochs = 10;
+  std::vector<DdKey> failed_full_set_;  // the full DD set whose integer search last failed (empty: none)
+  int epochs_since_full_set_ = 0;       // epochs since the full set was last searched
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);

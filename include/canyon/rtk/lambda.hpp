@@ -27,12 +27,14 @@
 //                 d_k + L_{k+1,k}^2 d_{k+1} < d_{k+1} (the swap makes d_{k+1} smaller), restarting from k = n - 1.
 //                 The swap test only involves L_{k+1,k}, so only that entry is size-reduced before each test; the
 //                 rest of column k is size-reduced just before a swap at k (it moves into column k + 1 and would
-//                 otherwise grow), and one pass after the last swap size-reduces all of L. The swaps and d are
-//                 those of MLAMBDA's reduction; the Gauss transformations skipped are those that cannot change a
-//                 swap decision or the search (Xie, Chang, Al Borno 2011, "Partial LLL reduction", Proc. IEEE
-//                 GLOBECOM; arXiv:1204.1398). Z, when kept, accumulates all transformations; decorrelate()
-//                 accumulates Z^{-1} alongside, mlambda() logs the elementary operations instead and back-transforms
-//                 only the m candidates, a = Z^{-T} z (exact integer arithmetic either way).
+//                 otherwise grow). decorrelate() then size-reduces all of L in one pass; mlambda() does not, as
+//                 those transformations cannot change the nodes the search visits (each is an integer shift of the
+//                 levels below). The swaps and d are those of MLAMBDA's reduction; the Gauss transformations
+//                 skipped are those that cannot change a swap decision or the search (Xie, Chang, Al Borno 2011,
+//                 "Partial LLL reduction", Proc. IEEE GLOBECOM; arXiv:1204.1398). Z, when kept, accumulates all
+//                 transformations; decorrelate() accumulates Z^{-1} alongside, mlambda() logs the elementary operations
+//                 instead and back-transforms only the m candidates, a = Z^{-T} z (exact integer arithmetic either
+//                 way).
 //              3. Search (Schnorr-Euchner enumeration, depth first, shrinking ellipsoid): with e = L^{-T}(z - z_hat),
 //                 ||.||^2 = sum_k (z_k - zbar_k)^2 / d_k, zbar_k = z_hat_k + sum_{j>k} L_jk (z_j - zbar_j)
 //                 (the conditional mean of z_k given z_{k+1..n}),
