@@ -166,7 +166,7 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
 std::string FusionEngine::validate_float(const rtk::RtkEpoch& epoch) const {
   if (epoch.num_dd_measurements == 0) return "no double-differenced phase";
   if (epoch.max_post_fit_normalised > options_.max_post_fit_normalised) {
-    return format("post-fit residual %.1f sigma", epoch.max_post_fit_normalised);
+    return format("post-fit residual %.1f times the rejection threshold", epoch.max_post_fit_normalised);
   }
   const double c = chi2(epoch.float_p_E_m - epoch.prior_p_E_m, epoch.prior_P_E_m2);
   if (c > options_.max_prior_chi2) {

@@ -18,8 +18,8 @@
 //     the VIO incremental motion, at least min_gate_m; applied to phase only: DD code noise is of that size) and/or
 //     DD phase and code innovations beyond gate_sigmas sqrt(h P h^T + r) (chi-square gate).
 //  Beyond the paper, before all that, the C/N0 screen (cn0_screen.hpp) removes suspected NLOS signals.
-//  5. Float validation: at least one DD phase used; the largest normalised post-fit phase residual <=
-//     max_post_fit_normalised; the float position consistent with the prior,
+//  5. Float validation: at least one DD phase used; the largest DD post-fit residual, over the RTK engine's rejection
+//     threshold, <= max_post_fit_normalised; the float position consistent with the prior,
 //     (p_float - p_prior)^T P_prior^-1 (p_float - p_prior) <= max_prior_chi2. If it fails: the update is undone and
 //     the epoch's output is the prior (aligned VIO fill-in, Q = 7). Beyond the paper, two recoveries from a prior
 //     that drifted (a poor alignment, a long fill-in): after max_prior_rejections consecutive epochs failing only the
@@ -81,13 +81,14 @@ struct FusionOptions {
   double gate_motion_factor = 5.0;       ///< paper: 5 x the VIO incremental motion
   double min_gate_m = 0.5;               ///< the motion gate is at least this (standing still) (m)
   double gate_sigmas = 4.0;              ///< chi-square gate: |v| <= this x sqrt(h P h^T + r)
-  double max_post_fit_normalised = 4.0;  ///< float validation: largest normalised post-fit DD phase residual
+  double max_post_fit_normalised = 1.0;  ///< float validation: largest DD post-fit residual over the RTK engine's
+                                         ///< rejection threshold (1: the engine's own max_post_fit_sigmas)
   double max_prior_chi2 = 16.27;         ///< float validation: chi-square(3) of the float against the prior (0.999)
   bool false_fix_guard = true;           ///< beyond the paper: fixes must agree with the prior
   double false_fix_chi2 = 16.27;         ///< chi-square(3) bound of the guard (0.999)
   double max_fix_sigma_m = 0.1;          ///< a fix whose position sigma (largest axis) exceeds this is not taken:
                                          ///< its DD geometry leaves the position undetermined (too few satellites)
-  Cn0ScreenOptions cn0{false};           ///< beyond the paper: NLOS screening by C/N0 (cn0_screen.hpp), off
+  Cn0ScreenOptions cn0;                  ///< beyond the paper: NLOS screening by C/N0 (cn0_screen.hpp)
   int max_prior_rejections = 5;          ///< after this many consecutive epochs whose float failed only the prior
                                          ///< check, the float is taken: GNSS re-anchors a drifted VIO prior
   int gate_conflict_epochs = 5;          ///< after this many consecutive epochs in which the gates rejected more DD
