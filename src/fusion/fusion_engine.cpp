@@ -190,13 +190,18 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
   guard_rejections_epoch_ = 0;
   undetermined_fixes_epoch_ = 0;
   std::optional<rtk::RtkAiding> aiding = make_aiding(rover.time, pose);
+  // The C/N0 screen learns from every epoch but screens only aided ones: before the VIO is aligned the RTK engine
+  // needs every signal it can get for the solutions the alignment starts from.
   core::ObsEpoch screened;
   const core::ObsEpoch* observed = &rover;
   if (options_.cn0.enabled && engine_.has_position()) {
     screened = rover;
     const Eigen::Vector3d p_approx = prior_ ? prior_->p_E_m : engine_.position_E_m();
-    stats_.cn0_screened += cn0_screen_.apply(screened, ephemerides_, p_approx);
-    observed = &screened;
+    const int removed = cn0_screen_.apply(screened, ephemerides_, p_approx);
+    if (aiding) {
+      stats_.cn0_screened += removed;
+      observed = &screened;
+    }
   }
   auto result = engine_.process(*observed, base, aiding ? &*aiding : nullptr);
   if (undetermined_fixes_epoch_ > 0) ++stats_.undetermined_fix_epochs;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string_view>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include "canyon/io/text_reader.hpp"
@@ -19,8 +20,9 @@ constexpr int kCovarianceFields = 21;
 constexpr int kCrossFields = 36;
 constexpr std::size_t kMaxWarningsPerKind = 5;
 
-std::vector<std::string_view> split_csv(std::string_view line) {
-  std::vector<std::string_view> fields;
+/// The fields of a CSV line into `fields` (reused between lines).
+void split_csv(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
@@ -29,6 +31,11 @@ std::vector<std::string_view> split_csv(std::string_view line) {
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
+}
+
+std::vector<std::string_view> split_csv(std::string_view line) {
+  std::vector<std::string_view> fields;
+  split_csv(line, fields);
   return fields;
 }
 
@@ -106,9 +113,10 @@ Result<VioFile> read_vio_csv(const std::string& path) {
   WarningList non_monotonic(file.warnings, "poses dropped for a time not after the previous pose's");
   WarningList not_pd(file.warnings, "poses dropped for a covariance that is not positive definite");
   bool previous_dropped = false;
+  std::vector<std::string_view> fields;
   while (const auto line = reader.next_line()) {
     if (trim(*line).empty()) continue;
-    const std::vector<std::string_view> fields = split_csv(*line);
+    split_csv(*line, fields);
     if (static_cast<int>(fields.size()) != columns) {
       const Error bad = reader.error("expected " + std::to_string(columns) + " fields as in the header, found " +
                                      std::to_string(fields.size()));
@@ -155,9 +163,10 @@ Result<VioFile> read_vio_csv(const std::string& path) {
       previous_dropped = true;
       continue;
     }
-    const double smallest =
-        Eigen::SelfAdjointEigenSolver<core::Matrix6d>(r.covariance, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
-    if (!(smallest > 0.0)) {
+    // Cholesky succeeds exactly for a positive definite matrix; the eigenvalues are only for the message.
+    if (Eigen::LLT<core::Matrix6d>(r.covariance).info() != Eigen::Success) {
+      const double smallest =
+          Eigen::SelfAdjointEigenSolver<core::Matrix6d>(r.covariance, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
       ++file.dropped_not_positive_definite;
       not_pd.add(reader
                      .error("covariance is not positive definite (smallest eigenvalue " + std::to_string(smallest) +

@@ -17,7 +17,8 @@
 //  4. Outlier satellite pruning in the update: DD phase innovations beyond gate_motion_factor x |dp_E| (the paper: 5x
 //     the VIO incremental motion, at least min_gate_m; applied to phase only: DD code noise is of that size) and/or
 //     DD phase and code innovations beyond gate_sigmas sqrt(h P h^T + r) (chi-square gate).
-//  Beyond the paper, before all that, the C/N0 screen (cn0_screen.hpp) removes suspected NLOS signals.
+//  Beyond the paper, before all that, the C/N0 screen (cn0_screen.hpp) removes suspected NLOS signals of aided epochs
+//  (it learns from all: before the alignment the RTK engine needs every signal for the solutions it aligns with).
 //  5. Float validation: at least one DD phase used; the largest DD post-fit residual, over the RTK engine's rejection
 //     threshold, <= max_post_fit_normalised; the float position consistent with the prior,
 //     (p_float - p_prior)^T P_prior^-1 (p_float - p_prior) <= max_prior_chi2. If it fails: the update is undone and
