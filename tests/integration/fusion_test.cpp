@@ -197,7 +197,8 @@ TEST(FusionCli, UrbanSevereSolvesEveryEpochWithoutWrongFixesAndBeatsRtklib) {
 class FusionBadInput : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = test::temp_dir("fusion-bad") / "scenario";
+    // One folder per process: ctest runs each test of the suite in its own process, in parallel.
+    dir_ = test::temp_dir("fusion-bad") / ("scenario-" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     const auto r = canyon("simulate -q --scenario open-sky --duration 30 --out " + dir_.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
