@@ -43,17 +43,19 @@ Result<sim::Scenario> demo_scenario(const DemoConfig& config) {
 Result<ProcessSummary> process_scenario(ProcessConfig config, const std::string& scenario_dir, const std::string& out) {
   config.rover_obs = path_in(scenario_dir, "rover.obs");
   config.base_obs = path_in(scenario_dir, "base.obs");
+  config.vio = path_in(scenario_dir, "vio.csv");
+  config.timesync = path_in(scenario_dir, "timesync.csv");
   config.nav = {path_in(scenario_dir, "nav.rnx")};
   config.out = out;
   return run_process(config);
 }
 
-Result<ProcessConfig> rtk_config(const DemoConfig& config) {
-  auto file = find_shipped_config(config.rtk_config);
+Result<ProcessConfig> shipped_process_config(const std::string& name, ProcessMode mode) {
+  auto file = find_shipped_config(name);
   if (!file) return file.error();
   auto loaded = load_process_config(*file);
   if (!loaded) return loaded.error();
-  loaded->mode = ProcessMode::Rtk;
+  loaded->mode = mode;
   return loaded;
 }
 
@@ -118,8 +120,10 @@ Result<DemoSummary> run_demo(const DemoConfig& config, const DemoLog& log) {
   DemoSummary summary;
   auto scenario = demo_scenario(config);
   if (!scenario) return scenario.error();
-  auto rtk = rtk_config(config);
+  auto rtk = shipped_process_config(config.rtk_config, ProcessMode::Rtk);
   if (!rtk) return rtk.error();
+  auto fusion = shipped_process_config(config.fusion_config, ProcessMode::Fusion);
+  if (!fusion) return fusion.error();
   std::error_code ec;
   fs::create_directories(config.out_dir, ec);
   if (ec) return Error{"cannot create the output folder: " + ec.message(), config.out_dir, 0};
@@ -149,7 +153,13 @@ Result<DemoSummary> run_demo(const DemoConfig& config, const DemoLog& log) {
   };
   ProcessConfig spp;
   spp.mode = ProcessMode::Spp;
-  for (const Mode& mode : {Mode{"canyon SPP", "spp.pos", spp}, Mode{"canyon RTK", "rtk.pos", *rtk}}) {
+  std::vector<Mode> modes = {Mode{"canyon SPP", "spp.pos", spp}, Mode{"canyon RTK", "rtk.pos", *rtk}};
+  if (scenario->vio.enabled) {
+    modes.push_back(Mode{"canyon fusion", "fusion.pos", *fusion});
+  } else {
+    summary.notes.emplace_back("the scenario has no VIO (vio.enabled: false): no fusion");
+  }
+  for (const Mode& mode : modes) {
     say(log, std::string("canyon process --mode ") + mode_name(mode.config.mode));
     const std::string out = path_in(config.out_dir, mode.file);
     auto processed = process_scenario(mode.config, scenario_dir, out);

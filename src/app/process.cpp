@@ -7,11 +7,15 @@
 #include <cstdio>
 
 #include "canyon/core/geodesy.hpp"
+#include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/fusion/time_bridge.hpp"
+#include "canyon/fusion/vio_track.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/io/nmea.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
+#include "canyon/io/vio_file.hpp"
 #include "canyon/rtk/engine.hpp"
 
 namespace canyon::app {
@@ -195,7 +199,7 @@ class SatelliteTally {
 /// exclusion lists. Returns them.
 Result<std::vector<core::SatelliteId>> exclude_most_observed(ProcessConfig& config, const io::ObsFilter& filter) {
   if (config.exclude_most_observed <= 0) return std::vector<core::SatelliteId>{};
-  const core::ConstellationFlags& systems = config.mode == ProcessMode::Rtk
+  const core::ConstellationFlags& systems = config.mode != ProcessMode::Spp
                                                 ? static_cast<const core::ConstellationFlags&>(config.rtk.observables)
                                                 : static_cast<const core::ConstellationFlags&>(config.spp);
   auto rover = ObservationStream::open(config.rover_obs, filter);
@@ -220,7 +224,11 @@ std::vector<std::string> header_lines(const ProcessConfig& config,
   std::vector<std::string> lines;
   lines.push_back("program   : canyon process (mode " + mode_name(config.mode) + ")");
   lines.push_back("inp file  : " + config.rover_obs);
-  if (config.mode == ProcessMode::Rtk) lines.push_back("inp file  : " + config.base_obs);
+  if (config.mode != ProcessMode::Spp) lines.push_back("inp file  : " + config.base_obs);
+  if (config.mode == ProcessMode::Fusion) {
+    lines.push_back("inp file  : " + config.vio);
+    if (!config.timesync.empty()) lines.push_back("inp file  : " + config.timesync);
+  }
   for (const std::string& n : config.nav) lines.push_back("inp file  : " + n);
   char mask[64];
   std::snprintf(mask, sizeof mask, "elev mask : %.1f deg", config.spp.elevation_mask_rad * 57.29577951308232);
@@ -281,6 +289,7 @@ const char* status_word(core::SolutionStatus status) {
     case core::SolutionStatus::Fixed: return "fixed";
     case core::SolutionStatus::Float: return "float";
     case core::SolutionStatus::Single: return "single";
+    case core::SolutionStatus::VioFillIn: return "VIO fill-in";
     default: return "other";
   }
 }
@@ -340,6 +349,106 @@ Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
   return Ok{};
 }
 
+std::string gps_text(const core::GpsTime& t) {
+  const core::GpsTime n = t.normalized();
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%d %.3f", n.week, n.tow_s);
+  return buffer;
+}
+
+/// The VIO trajectory on GPST: vio.csv through the time bridge (timesync.csv, unless the VIO is on GPST), split into
+/// segments.
+Result<fusion::VioTrack> load_vio(const ProcessConfig& config, ProcessSummary& summary) {
+  auto vio = io::read_vio_csv(config.vio);
+  if (!vio) return vio.error();
+  summary.warnings.insert(summary.warnings.end(), vio->warnings.begin(), vio->warnings.end());
+  if (!vio->has_cross_covariance) {
+    summary.warnings.push_back(config.vio +
+                               ": no cross-covariance columns: consecutive VIO poses taken as uncorrelated (the "
+                               "increments' covariance is then the sum of the poses' covariances, pessimistic)");
+  }
+  fusion::TimeBridge bridge = fusion::TimeBridge::gps_clock();
+  char line[200];
+  if (config.fusion.vio_on_gps_time) {
+    summary.report.emplace_back("fusion: VIO time stamps taken as GPST (vio_clock: gps), no time sync");
+  } else {
+    auto sync = io::read_timesync_csv(config.timesync);
+    if (!sync) return sync.error();
+    summary.warnings.insert(summary.warnings.end(), sync->warnings.begin(), sync->warnings.end());
+    auto fit = fusion::fit_time_bridge(sync->pairs, config.fusion.time_sync);
+    if (!fit) return Error{fit.error().message, config.timesync, 0};
+    for (const std::string& w : fit->warnings) summary.warnings.push_back(config.timesync + ": " + w);
+    bridge = fit->bridge;
+    std::snprintf(line, sizeof line,
+                  "fusion: time bridge from %d pairs: device clock drift %.2f ppm, residual RMS %.3f ms (max %.3f "
+                  "ms), %zu outlier pairs rejected",
+                  fit->pairs, bridge.drift_ppm(), fit->residual_rms_s * 1e3, fit->max_residual_s * 1e3,
+                  fit->outlier_lines.size());
+    summary.report.emplace_back(line);
+    if (!fit->outlier_lines.empty()) {
+      std::string lines = "fusion: time-sync outliers at lines";
+      for (std::size_t i = 0; i < fit->outlier_lines.size() && i < 10; ++i) {
+        lines += ' ';
+        lines += std::to_string(fit->outlier_lines[i]);
+      }
+      if (fit->outlier_lines.size() > 10) lines += " ...";
+      summary.report.push_back(lines);
+    }
+  }
+  std::vector<std::string> notes;
+  auto track = fusion::VioTrack::build(*vio, bridge, config.fusion.vio, notes);
+  if (!track) return Error{track.error().message, config.vio, 0};
+  for (const std::string& n : notes) summary.report.push_back("fusion: " + n);
+  return track;
+}
+
+Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
+                  BaseCursor& base, const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
+                  const ProgressFn& progress) {
+  auto track = load_vio(config, summary);
+  if (!track) return track.error();
+  const core::GpsTime vio_first = track->first_time();
+  const core::GpsTime vio_last = track->last_time();
+  fusion::FusionEngine engine(config.fusion, config.rtk, ephemerides, p_E_base, std::move(*track));
+  std::optional<core::GpsTime> first;
+  core::GpsTime last;
+  int overlapping = 0;
+  for (;;) {
+    auto next = rover.next();
+    if (!next) return next.error();
+    if (!*next) break;
+    const core::ObsEpoch& epoch = **next;
+    if (!first) first = epoch.time;
+    last = epoch.time;
+    if (!(epoch.time < vio_first) && !(vio_last < epoch.time)) ++overlapping;
+    ++summary.epochs;
+    auto base_epoch = base.at(epoch.time);
+    if (!base_epoch) return base_epoch.error();
+    auto result = engine.process(epoch, *base_epoch);
+    if (result) {
+      if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
+      ++summary.solved;
+      if (result->solution.status == core::SolutionStatus::Fixed) {
+        ++summary.fixed;
+      } else {
+        add_epoch_note(summary, epoch.time, status_word(result->solution.status), result->note);
+      }
+    } else {
+      add_epoch_note(summary, epoch.time, "no solution", result.error().message);
+    }
+    report(progress, summary, rover);
+  }
+  if (first && overlapping == 0) {
+    return Error{"the VIO (GPST " + gps_text(vio_first) + " to " + gps_text(vio_last) +
+                     ") does not overlap the rover epochs (GPST " + gps_text(*first) + " to " + gps_text(last) +
+                     "): wrong file, or wrong time sync" + (config.fusion.vio_on_gps_time ? " (vio_clock: gps)" : ""),
+                 config.vio, 0};
+  }
+  const std::vector<std::string> lines = engine.report();
+  summary.report.insert(summary.report.end(), lines.begin(), lines.end());
+  return Ok{};
+}
+
 }  // namespace
 
 std::vector<core::SatelliteId> most_observed_satellites(const std::vector<core::ObsEpoch>& epochs, int n,
@@ -358,7 +467,7 @@ io::ObsFilter observation_filter(const ProcessConfig& config) {
   const core::ConstellationFlags& spp = config.spp;
   filter.systems = spp;
   filter.max_frequency_rank = 0;
-  if (config.mode == ProcessMode::Rtk) {
+  if (config.mode != ProcessMode::Spp) {
     const core::ConstellationFlags& rtk = config.rtk.observables;
     filter.systems.use_gps = spp.use_gps || rtk.use_gps;
     filter.systems.use_glonass = spp.use_glonass || rtk.use_glonass;
@@ -391,7 +500,7 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
 
   std::optional<BaseCursor> base;
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
-  if (config.mode == ProcessMode::Rtk) {
+  if (config.mode != ProcessMode::Spp) {
     auto base_stream = ObservationStream::open(config.base_obs, filter);
     if (!base_stream) return base_stream.error();
     if (config.base_position_E_m) {
@@ -419,9 +528,16 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
     if (!nmea) return nmea.error();
     outputs.nmea = std::move(*nmea);
   }
-  const Status run = config.mode == ProcessMode::Rtk
-                         ? run_rtk(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress)
-                         : run_spp(config, ephemerides, *rover, outputs, summary, progress);
+  Status run = Ok{};
+  switch (config.mode) {
+    case ProcessMode::Rtk:
+      run = run_rtk(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress);
+      break;
+    case ProcessMode::Fusion:
+      run = run_fusion(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress);
+      break;
+    case ProcessMode::Spp: run = run_spp(config, ephemerides, *rover, outputs, summary, progress); break;
+  }
   if (!run) return run.error();
   if (Status c = outputs.close(); !c) return c.error();
   rover->append_warnings(summary.warnings);

@@ -127,6 +127,88 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.reject_unknown_keys();
 }
 
+void parse_vector3(YamlMap& map, const std::string& key, Eigen::Vector3d& v) {
+  if (!map.has(key)) return;
+  std::vector<double> values;
+  map.get(key, values);
+  if (values.size() != 3) {
+    map.fail(key, "must be [x, y, z] (m)");
+    return;
+  }
+  v = Eigen::Vector3d(values[0], values[1], values[2]);
+}
+
+void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
+  std::string clock = o.vio_on_gps_time ? "gps" : "device";
+  map.get("vio_clock", clock);
+  if (clock != "device" && clock != "gps") map.fail("vio_clock", "must be device or gps, not '" + clock + "'");
+  o.vio_on_gps_time = clock == "gps";
+  map.get("timesync_outlier_sigmas", o.time_sync.outlier_sigmas);
+  map.get("timesync_min_outlier_threshold_s", o.time_sync.min_outlier_threshold_s);
+  map.get("timesync_max_residual_rms_s", o.time_sync.max_residual_rms_s);
+  map.get("timesync_max_drift_ppm", o.time_sync.max_drift_ppm);
+  map.get("vio_max_gap_s", o.vio.max_gap_s);
+  map.get("vio_max_speed_mps", o.vio.max_speed_mps);
+  map.get("vio_max_rotation_rate_dps", o.vio.max_rotation_rate_dps);
+  map.get("vio_reset_covariance_ratio", o.vio.reset_covariance_ratio);
+  map.get("vio_cross_covariance", o.vio.use_cross_covariance);
+  map.get("alignment_max_fer", o.alignment.max_first_eigenvalue_ratio);
+  map.get("alignment_max_rmse_m", o.alignment.max_rmse_m);
+  map.get("alignment_min_points", o.alignment.min_points);
+  map.get("alignment_window_s", o.alignment_window_s);
+  map.get("alignment_interval_s", o.alignment_interval_s);
+  map.get("realign_interval_s", o.realign_interval_s);
+  map.get("alignment_max_window_sigma_m", o.max_window_sigma_m);
+  map.get("calibrate_lever_arm", o.calibrate_lever_arm);
+  parse_vector3(map, "lever_arm_prior_m", o.lever_arm_prior_m);
+  map.get("lever_arm_min_excitation", o.alignment.min_lever_arm_excitation);
+  map.get("coarse_alignment", o.coarse_alignment);
+  map.get("coarse_window_s", o.coarse_window_s);
+  map.get("coarse_min_spread_m", o.coarse_min_spread_m);
+  map.get("coarse_max_yaw_sigma_deg", o.coarse_max_yaw_sigma_deg);
+  std::string prediction = fusion::prediction_name(o.prediction);
+  map.get("prediction", prediction);
+  if (prediction == "vio") {
+    o.prediction = fusion::Prediction::Vio;
+  } else if (prediction == "constant_velocity") {
+    o.prediction = fusion::Prediction::ConstantVelocity;
+  } else {
+    map.fail("prediction", "must be vio or constant_velocity, not '" + prediction + "'");
+  }
+  map.get("vio_covariance", o.vio_covariance);
+  map.get("constant_increment_sigma_m", o.constant_increment_sigma_m);
+  std::string gate = fusion::innovation_gate_name(o.gate);
+  map.get("gate", gate);
+  if (gate == "off") {
+    o.gate = fusion::InnovationGate::Off;
+  } else if (gate == "paper") {
+    o.gate = fusion::InnovationGate::Paper;
+  } else if (gate == "chi_square") {
+    o.gate = fusion::InnovationGate::ChiSquare;
+  } else if (gate == "both") {
+    o.gate = fusion::InnovationGate::Both;
+  } else {
+    map.fail("gate", "must be off, paper, chi_square or both, not '" + gate + "'");
+  }
+  map.get("gate_motion_factor", o.gate_motion_factor);
+  map.get("min_gate_m", o.min_gate_m);
+  map.get("gate_sigmas", o.gate_sigmas);
+  map.get("max_post_fit_normalised", o.max_post_fit_normalised);
+  map.get("max_prior_chi2", o.max_prior_chi2);
+  map.get("false_fix_guard", o.false_fix_guard);
+  map.get("false_fix_chi2", o.false_fix_chi2);
+  map.get("max_fix_sigma_m", o.max_fix_sigma_m);
+  map.get("max_prior_rejections", o.max_prior_rejections);
+  map.get("gate_conflict_epochs", o.gate_conflict_epochs);
+  map.get("reanchor_sigma_m", o.reanchor_sigma_m);
+  map.get("cn0_screen", o.cn0.enabled);
+  map.get("cn0_margin_db", o.cn0.margin_db);
+  map.get("cn0_quantile", o.cn0.quantile);
+  map.get("cn0_bin_deg", o.cn0.bin_deg);
+  map.get("cn0_min_samples", o.cn0.min_samples);
+  map.reject_unknown_keys();
+}
+
 void parse_spp(YamlMap map, gnss::SppOptions& o) {
   parse_angle_deg(map, "elevation_mask_deg", o.elevation_mask_rad);
   parse_systems(map, o);
@@ -154,6 +236,7 @@ std::string mode_name(ProcessMode mode) {
   switch (mode) {
     case ProcessMode::Spp: return "spp";
     case ProcessMode::Rtk: return "rtk";
+    case ProcessMode::Fusion: return "fusion";
   }
   return "?";
 }
@@ -164,9 +247,17 @@ std::string ProcessConfig::validate() const {
   if (out.empty()) return "a solution file is required (--out or 'out:')";
   if (exclude_most_observed < 0) return "exclude_most_observed must be >= 0";
   if (const std::string e = spp.validate(); !e.empty()) return "spp: " + e;
-  if (mode == ProcessMode::Rtk) {
-    if (base_obs.empty()) return "rtk needs a base observation file (--base or 'base:')";
+  if (mode == ProcessMode::Rtk || mode == ProcessMode::Fusion) {
+    if (base_obs.empty()) return mode_name(mode) + " needs a base observation file (--base or 'base:')";
     if (const std::string e = rtk.validate(); !e.empty()) return "rtk: " + e;
+  }
+  if (mode == ProcessMode::Fusion) {
+    if (vio.empty()) return "fusion needs a VIO file (--vio or 'vio:')";
+    if (timesync.empty() && !fusion.vio_on_gps_time) {
+      return "fusion needs a time-sync file (--timesync or 'timesync:'), or fusion.vio_clock: gps for VIO stamped "
+             "with GPST";
+    }
+    if (const std::string e = fusion.validate(); !e.empty()) return "fusion: " + e;
   }
   return {};
 }
@@ -184,13 +275,19 @@ Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::st
     c.mode = ProcessMode::Spp;
   } else if (mode == "rtk") {
     c.mode = ProcessMode::Rtk;
+  } else if (mode == "fusion") {
+    c.mode = ProcessMode::Fusion;
   } else {
-    top.fail("mode", "must be spp or rtk (fusion is not available yet), not '" + mode + "'");
+    top.fail("mode", "must be spp, rtk or fusion, not '" + mode + "'");
   }
   top.get("rover", c.rover_obs);
   c.rover_obs = resolve(c.rover_obs, file);
   top.get("base", c.base_obs);
   c.base_obs = resolve(c.base_obs, file);
+  top.get("vio", c.vio);
+  c.vio = resolve(c.vio, file);
+  top.get("timesync", c.timesync);
+  c.timesync = resolve(c.timesync, file);
   if (top.has("base_position")) {
     std::vector<std::string> xyz;
     top.get("base_position", xyz);
@@ -235,10 +332,12 @@ Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::st
   }
   parse_spp(top.sub("spp"), c.spp);
   parse_rtk(top.sub("rtk"), c.rtk);
+  parse_fusion(top.sub("fusion"), c.fusion);
   top.reject_unknown_keys();
   if (Status s = top.status(); !s) return s.error();
   if (const std::string e = c.spp.validate(); !e.empty()) return Error{"spp: " + e, file, 0};
   if (const std::string e = c.rtk.validate(); !e.empty()) return Error{"rtk: " + e, file, 0};
+  if (const std::string e = c.fusion.validate(); !e.empty()) return Error{"fusion: " + e, file, 0};
   return c;
 }
 
@@ -297,6 +396,57 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::EndMap;
 }
 
+static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
+  const auto key = [&out](const char* k) -> YAML::Emitter& { return out << YAML::Key << k << YAML::Value; };
+  out << YAML::Key << "fusion" << YAML::Value << YAML::BeginMap;
+  key("vio_clock") << (o.vio_on_gps_time ? "gps" : "device");
+  key("timesync_outlier_sigmas") << o.time_sync.outlier_sigmas;
+  key("timesync_min_outlier_threshold_s") << o.time_sync.min_outlier_threshold_s;
+  key("timesync_max_residual_rms_s") << o.time_sync.max_residual_rms_s;
+  key("timesync_max_drift_ppm") << o.time_sync.max_drift_ppm;
+  key("vio_max_gap_s") << o.vio.max_gap_s;
+  key("vio_max_speed_mps") << o.vio.max_speed_mps;
+  key("vio_max_rotation_rate_dps") << o.vio.max_rotation_rate_dps;
+  key("vio_reset_covariance_ratio") << o.vio.reset_covariance_ratio;
+  key("vio_cross_covariance") << o.vio.use_cross_covariance;
+  key("alignment_max_fer") << o.alignment.max_first_eigenvalue_ratio;
+  key("alignment_max_rmse_m") << o.alignment.max_rmse_m;
+  key("alignment_min_points") << o.alignment.min_points;
+  key("alignment_window_s") << o.alignment_window_s;
+  key("alignment_interval_s") << o.alignment_interval_s;
+  key("realign_interval_s") << o.realign_interval_s;
+  key("alignment_max_window_sigma_m") << o.max_window_sigma_m;
+  key("calibrate_lever_arm") << o.calibrate_lever_arm;
+  key("lever_arm_prior_m") << YAML::Flow << YAML::BeginSeq << o.lever_arm_prior_m.x() << o.lever_arm_prior_m.y()
+                           << o.lever_arm_prior_m.z() << YAML::EndSeq;
+  key("lever_arm_min_excitation") << o.alignment.min_lever_arm_excitation;
+  key("coarse_alignment") << o.coarse_alignment;
+  key("coarse_window_s") << o.coarse_window_s;
+  key("coarse_min_spread_m") << o.coarse_min_spread_m;
+  key("coarse_max_yaw_sigma_deg") << o.coarse_max_yaw_sigma_deg;
+  key("prediction") << fusion::prediction_name(o.prediction);
+  key("vio_covariance") << o.vio_covariance;
+  key("constant_increment_sigma_m") << o.constant_increment_sigma_m;
+  key("gate") << fusion::innovation_gate_name(o.gate);
+  key("gate_motion_factor") << o.gate_motion_factor;
+  key("min_gate_m") << o.min_gate_m;
+  key("gate_sigmas") << o.gate_sigmas;
+  key("max_post_fit_normalised") << o.max_post_fit_normalised;
+  key("max_prior_chi2") << o.max_prior_chi2;
+  key("false_fix_guard") << o.false_fix_guard;
+  key("false_fix_chi2") << o.false_fix_chi2;
+  key("max_fix_sigma_m") << o.max_fix_sigma_m;
+  key("max_prior_rejections") << o.max_prior_rejections;
+  key("gate_conflict_epochs") << o.gate_conflict_epochs;
+  key("reanchor_sigma_m") << o.reanchor_sigma_m;
+  key("cn0_screen") << o.cn0.enabled;
+  key("cn0_margin_db") << o.cn0.margin_db;
+  key("cn0_quantile") << o.cn0.quantile;
+  key("cn0_bin_deg") << o.cn0.bin_deg;
+  key("cn0_min_samples") << o.cn0.min_samples;
+  out << YAML::EndMap;
+}
+
 std::string to_yaml(const ProcessConfig& c) {
   YAML::Emitter out;
   out.SetDoublePrecision(12);  // shortest form of the configured values (0.99, not 0.98999999999999999)
@@ -304,6 +454,8 @@ std::string to_yaml(const ProcessConfig& c) {
   out << YAML::Key << "mode" << YAML::Value << mode_name(c.mode);
   out << YAML::Key << "rover" << YAML::Value << c.rover_obs;
   out << YAML::Key << "base" << YAML::Value << c.base_obs;
+  out << YAML::Key << "vio" << YAML::Value << c.vio;
+  out << YAML::Key << "timesync" << YAML::Value << c.timesync;
   if (c.base_position_E_m) {
     out << YAML::Key << "base_position" << YAML::Value << YAML::Flow << YAML::BeginSeq << c.base_position_E_m->x()
         << c.base_position_E_m->y() << c.base_position_E_m->z() << YAML::EndSeq;
@@ -332,6 +484,7 @@ std::string to_yaml(const ProcessConfig& c) {
   out << YAML::Key << "exclude" << YAML::Value << YAML::Flow << excluded;
   out << YAML::EndMap;
   emit_rtk(out, c.rtk);
+  emit_fusion(out, c.fusion);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

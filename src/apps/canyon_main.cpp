@@ -54,6 +54,8 @@ struct ProcessArgs {
   std::string mode;
   std::string rover;
   std::string base;
+  std::string vio;
+  std::string timesync;
   std::string base_pos;
   std::string exclude_sats;
   int exclude_most_observed = -1;
@@ -72,9 +74,12 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   CLI::App* cmd = app.add_subcommand("process", "Process recorded observations into a solution file (.pos)");
   cmd->add_option("--config", args.config_file, "YAML configuration (strict: unknown keys are errors)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--mode", args.mode, "Processing mode: spp or rtk")->check(CLI::IsMember({"spp", "rtk"}));
+  cmd->add_option("--mode", args.mode, "Processing mode: spp, rtk or fusion (RTK aided by VIO, the paper's method)")
+      ->check(CLI::IsMember({"spp", "rtk", "fusion"}));
   cmd->add_option("--rover", args.rover, "Rover RINEX observation file (2.x/3.x, may be gzip-compressed)");
-  cmd->add_option("--base", args.base, "Base RINEX observation file (rtk)");
+  cmd->add_option("--base", args.base, "Base RINEX observation file (rtk, fusion)");
+  cmd->add_option("--vio", args.vio, "VIO poses, vio.csv (fusion; DESIGN.md file contract)");
+  cmd->add_option("--timesync", args.timesync, "The VIO device's GPS time-sync pairs, timesync.csv (fusion)");
   cmd->add_option("--base-pos", args.base_pos, "Base antenna ECEF X,Y,Z in metres (default: base file header)");
   cmd->add_option("--exclude-sats", args.exclude_sats, "Satellites never used, e.g. G05,E11");
   cmd->add_option("--exclude-most-observed", args.exclude_most_observed,
@@ -106,10 +111,14 @@ int run_process_command(const ProcessArgs& args) {
     config = std::move(*loaded);
   }
   if (!args.mode.empty()) {
-    config.mode = args.mode == "rtk" ? canyon::app::ProcessMode::Rtk : canyon::app::ProcessMode::Spp;
+    config.mode = args.mode == "rtk"      ? canyon::app::ProcessMode::Rtk
+                  : args.mode == "fusion" ? canyon::app::ProcessMode::Fusion
+                                          : canyon::app::ProcessMode::Spp;
   }
   if (!args.rover.empty()) config.rover_obs = args.rover;
   if (!args.base.empty()) config.base_obs = args.base;
+  if (!args.vio.empty()) config.vio = args.vio;
+  if (!args.timesync.empty()) config.timesync = args.timesync;
   if (!args.base_pos.empty()) {
     double x = 0, y = 0, z = 0;
     char tail = 0;
@@ -187,9 +196,12 @@ int run_process_command(const ProcessArgs& args) {
     for (const std::string& note : summary->epoch_notes) std::fprintf(stderr, "canyon: %s\n", note.c_str());
   }
   if (!args.quiet) {
+    for (const std::string& line : summary->report) std::fprintf(stderr, "canyon process: %s\n", line.c_str());
+  }
+  if (!args.quiet) {
     const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;
     std::string fixed;
-    if (config.mode == canyon::app::ProcessMode::Rtk) {
+    if (config.mode != canyon::app::ProcessMode::Spp) {
       char buffer[64];
       std::snprintf(buffer, sizeof buffer, ", %d fixed (%.1f %%)", summary->fixed,
                     summary->epochs > 0 ? 100.0 * summary->fixed / summary->epochs : 0.0);
@@ -203,6 +215,7 @@ int run_process_command(const ProcessArgs& args) {
 
 struct SimulateArgs {
   std::string scenario;
+  std::string vio_from_truth;
   std::string out;
   std::int64_t seed = -1;
   double duration_s = -1.0;
@@ -213,8 +226,12 @@ void add_simulate_command(CLI::App& app, SimulateArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "simulate", "Generate a scenario: rover and base RINEX, navigation, ground truth and city model");
   cmd->add_option("--scenario", args.scenario,
-                  "Shipped scenario name (open-sky, light-blocked, urban-moderate, urban-severe) or a FILE.yaml")
-      ->required();
+                  "Shipped scenario name (open-sky, light-blocked, urban-moderate, urban-severe) or a FILE.yaml "
+                  "(with --vio-from-truth: its vio section, default urban-severe's)");
+  cmd->add_option("--vio-from-truth", args.vio_from_truth,
+                  "Only make VIO (vio.csv, timesync.csv, vio_truth.yaml) of a device carried along this 6-DoF truth: "
+                  "canyon truth.csv with qx,qy,qz,qw, or a Spirent PVA CSV with roll, pitch, yaw")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--seed", args.seed, "Random seed (default: the scenario's)")->check(CLI::Range(0LL, 1LL << 53));
   cmd->add_option("--duration", args.duration_s, "Duration in seconds (default: the scenario's)")
       ->check(CLI::Range(1.0, 86400.0));
@@ -222,7 +239,46 @@ void add_simulate_command(CLI::App& app, SimulateArgs& args) {
   cmd->add_flag("-q,--quiet", args.quiet, "No summary line");
 }
 
+int run_vio_from_truth_command(const SimulateArgs& args) {
+  canyon::sim::VioOptions vio;
+  std::uint64_t seed = 1;
+  if (!args.scenario.empty()) {
+    auto file = canyon::app::find_scenario_file(args.scenario);
+    if (!file) {
+      std::cerr << "canyon: error: " << file.error().to_string() << "\n";
+      return kExitUsage;
+    }
+    auto scenario = canyon::app::load_scenario(*file);
+    if (!scenario) {
+      std::cerr << "canyon: error: " << scenario.error().to_string() << "\n";
+      return kExitUsage;
+    }
+    vio = scenario->vio;
+    seed = scenario->seed;
+  }
+  if (args.seed >= 0) seed = static_cast<std::uint64_t>(args.seed);
+  auto summary = canyon::app::run_vio_from_truth(args.vio_from_truth, vio, seed, args.out);
+  if (!summary) {
+    std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
+    return kExitInput;
+  }
+  if (!args.quiet) {
+    std::fprintf(stderr,
+                 "canyon simulate: VIO from %s, seed %llu: %d poses, %d time-sync pairs over %.1f s, final VIO error "
+                 "%.3f m, %.2f s wall, files in %s\n",
+                 args.vio_from_truth.c_str(), static_cast<unsigned long long>(seed), summary->poses,
+                 summary->timesync_pairs, summary->duration_s, summary->final_position_error_m, summary->wall_s,
+                 args.out.c_str());
+  }
+  return 0;
+}
+
 int run_simulate_command(const SimulateArgs& args) {
+  if (!args.vio_from_truth.empty()) return run_vio_from_truth_command(args);
+  if (args.scenario.empty()) {
+    std::cerr << "canyon: error: simulate needs --scenario (or --vio-from-truth TRUTH)\n";
+    return kExitUsage;
+  }
   auto file = canyon::app::find_scenario_file(args.scenario);
   if (!file) {
     std::cerr << "canyon: error: " << file.error().to_string() << "\n";
@@ -327,7 +383,8 @@ struct DemoArgs {
 void add_demo_command(CLI::App& app, DemoArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "demo",
-      "canyon's main job, no external data: generate urban-severe, process it with SPP, RTK and RTKLIB, evaluate");
+      "canyon's main job, no external data: generate urban-severe, process it with SPP, RTK, fusion (VIO) and RTKLIB, "
+      "evaluate");
   canyon::app::DemoConfig& c = args.config;
   cmd->add_option("--scenario", c.scenario, "Shipped scenario name or a FILE.yaml (default urban-severe)");
   cmd->add_option("--seed", args.seed, "Random seed (default: the scenario's)")->check(CLI::Range(0LL, 1LL << 53));
@@ -339,7 +396,8 @@ void add_demo_command(CLI::App& app, DemoArgs& args) {
   cmd->add_flag("--no-rtklib", args.no_rtklib, "Do not run RTKLIB's rnx2rtkp as the baseline");
   cmd->add_option("--rtklib-program", c.rtklib_program, "RTKLIB's rnx2rtkp to run (default: rnx2rtkp on PATH)");
   cmd->footer(
-      "Writes DIR/scenario/ (canyon simulate's files), DIR/spp.pos, DIR/rtk.pos, DIR/rtklib.pos (+ rtklib.log), and "
+      "Writes DIR/scenario/ (canyon simulate's files), DIR/spp.pos, DIR/rtk.pos, DIR/fusion.pos, DIR/rtklib.pos (+ "
+      "rtklib.log), and "
       "canyon evaluate's DIR/evaluation.md, evaluation.json, trajectory.svg, ape.svg; prints the side-by-side table.\n"
       "Exit status: 0 success, 1 a stage failed (named), 2 bad command line or scenario.");
 }

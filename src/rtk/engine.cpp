@@ -328,6 +328,30 @@ const char* ionosphere_model_name(IonosphereModel model) {
   return "?";
 }
 
+namespace {
+
+/// The aiding's innovation gates on one DD row at the state (x, P): a fixed gate on rows whose predicted sigma
+/// sqrt(h P h^T) is within a third of it (not a new ambiguity), the normalised gate |v| <= k sqrt(h P h^T + r) on all.
+bool aided_gate_passes(const RtkAiding& aiding, const DdRow& row, const std::vector<SingleDiff>& sds,
+                       const Eigen::MatrixXd& P) {
+  const std::optional<double>& fixed_gate = row.phase ? aiding.max_phase_innovation_m : aiding.max_code_innovation_m;
+  if (!fixed_gate && !aiding.max_normalised_innovation) return true;
+  // Predicted sigma of the row, sqrt(h P h^T), and its measurement variance r.
+  Eigen::VectorXd P_h(P.rows());
+  row.covariance_times(P, P_h);
+  const double hPh = std::max(row.dot(P_h), 0.0);
+  const SingleDiff& sd = sds[static_cast<std::size_t>(row.sd)];
+  const SingleDiff& ref = sds[static_cast<std::size_t>(row.reference)];
+  const double r =
+      row.phase ? sd.phase_variance_m2 + ref.phase_variance_m2 : sd.code_variance_m2 + ref.code_variance_m2;
+  const double v = std::abs(row.innovation_m);
+  // A fixed gate judges only rows whose prediction is good to a third of it (not a new ambiguity).
+  if (fixed_gate && 9.0 * hPh <= *fixed_gate * *fixed_gate && v > *fixed_gate) return false;
+  return !(aiding.max_normalised_innovation && v > *aiding.max_normalised_innovation * std::sqrt(hPh + r));
+}
+
+}  // namespace
+
 const char* ar_mode_name(ArMode mode) {
   switch (mode) {
     case ArMode::Off: return "off";
@@ -494,6 +518,29 @@ void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp
   last_time_ = t;
 }
 
+void RtkEngine::aided_time_update(const core::GpsTime& t, const RtkAiding& aiding) {
+  // External motion as the model: x_p' = x_p + d, P_pp' = P_pp + Q; the position's correlations with the ambiguities
+  // carry over (x' = x + d with d independent of x). Other kinematic states (dynamics) are left as they are.
+  const double dt_s = last_time_ ? std::abs(t - *last_time_) : 0.0;
+  x_.head<3>() += aiding.delta_p_E_m;
+  P_.topLeftCorner<3, 3>() += 0.5 * (aiding.Q_E_m2 + aiding.Q_E_m2.transpose());
+  const int k = num_kinematic_states();
+  const double q_amb = options_.ambiguity_noise_cyc * options_.ambiguity_noise_cyc * dt_s;
+  const double q_iono = options_.iono_noise_m * options_.iono_noise_m * dt_s;
+  for (Eigen::Index i = k; i < x_.size(); ++i) {
+    P_(i, i) += ambiguity_keys_[static_cast<std::size_t>(i - k)].second == kIonoKey ? q_iono : q_amb;
+  }
+  last_time_ = t;
+}
+
+void RtkEngine::revert_to_prior() {
+  if (!has_prior_) return;
+  x_ = prior_x_;
+  P_ = prior_P_;
+  last_fix_ = prior_last_fix_;
+  has_prior_ = false;
+}
+
 void RtkEngine::detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base) {
   std::vector<SlipEvent> events = rover_slips_.update(rover);
   if (!last_base_time_ || std::abs(base.time - *last_base_time_) > 1e-6) {
@@ -564,6 +611,7 @@ int RtkEngine::measurement_update(std::vector<SingleDiff>& sds, std::vector<core
   for (int attempt = 0; attempt <= options_.max_post_fit_rejections; ++attempt) {
     PostFit post_fit;
     used = update_once(sds, rejected, post_fit);
+    last_post_fit_normalised_ = post_fit.worst_normalised;
     consistent = post_fit.worst_sd < 0 || post_fit.worst_normalised <= 1.0;
     if (consistent || attempt == options_.max_post_fit_rejections) break;
     SingleDiff& bad = sds[static_cast<std::size_t>(post_fit.worst_sd)];
@@ -626,8 +674,12 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
         // The SD residuals were formed at the prior position: the geometry term is already in observed_m, and
         // the position correction enters through H; at the prior, the predicted DD range residual is zero.
         row.innovation_m = observed_m - predicted_m;
-        const double gate = phase ? options_.max_phase_innovation_m : options_.max_code_innovation_m;
+        double gate = phase ? options_.max_phase_innovation_m : options_.max_code_innovation_m;
         if (std::abs(row.innovation_m) > gate) {
+          rejected.push_back(sd.sat);
+          continue;
+        }
+        if (aiding_ != nullptr && !aided_gate_passes(*aiding_, row, sds, P_)) {
           rejected.push_back(sd.sat);
           continue;
         }
@@ -707,6 +759,7 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
   };
   check(phase_rows, options_.max_post_fit_sigmas, false);
   check(code_rows, options_.max_post_fit_code_sigmas, true);
+  last_code_rows_ = static_cast<int>(code_rows.size());
   return static_cast<int>(phase_rows.size());
 }
 
@@ -823,7 +876,23 @@ std::string RtkEngine::rejection_reason(const Fix& fix) const {
 
 bool RtkEngine::accepted(const Fix& fix) const {
   if (!agrees_with_last_fix(fix)) return false;
-  return fix.ratio >= options_.ratio_threshold && fix.success_rate >= options_.min_success_rate;
+  if (!(fix.ratio >= options_.ratio_threshold && fix.success_rate >= options_.min_success_rate)) return false;
+  if (aiding_ != nullptr && aiding_->accept_fix) {
+    Eigen::Vector3d p;
+    Eigen::Matrix3d P;
+    return fix_position(fix, p, P) && aiding_->accept_fix(p, P);
+  }
+  return true;
+}
+
+bool RtkEngine::fix_position(const Fix& fix, Eigen::Vector3d& p, Eigen::Matrix3d& P) const {
+  const Eigen::LLT<Eigen::MatrixXd> llt(fix.Q_a);
+  if (llt.info() != Eigen::Success) return false;
+  // Only the position rows of P D^T are needed (the whole x_fix, P_fix would cost n^2 nd).
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> B = fix.PDt.topRows<3>();  // cov(p, a)
+  p = x_.head<3>() - B * llt.solve(fix.a_float - fix.a_fix);
+  P = P_.topLeftCorner<3, 3>() - B * llt.solve(B.transpose());
+  return true;
 }
 
 SatelliteId RtkEngine::satellite_of_state(int index) const {
@@ -856,6 +925,8 @@ std::optional<RtkEngine::Fix> RtkEngine::prune(Fix fix, int min_size) const {
              dd.end());
     auto next = try_fix(dd, min_size);
     if (!next) return std::nullopt;
+    next->pruned = fix.pruned;
+    next->pruned.push_back(worst);
     if (accepted(*next)) return next;
     fix = std::move(*next);
   }
@@ -911,10 +982,9 @@ std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full
   if (!accepted(sub)) return std::nullopt;
   // A few precise combinations need not pin the position down: the fix counts only if they do (otherwise the caller
   // may still use them to sharpen the float position).
-  const Eigen::LLT<Eigen::MatrixXd> llt(sub.Q_a);
-  if (llt.info() != Eigen::Success) return std::nullopt;
-  const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = sub.PDt.topRows<3>();
-  const Eigen::Matrix3d P_p = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
+  Eigen::Vector3d p;
+  Eigen::Matrix3d P_p;
+  if (!fix_position(sub, p, P_p)) return std::nullopt;
   sub.imprecise = !(std::sqrt(std::max(P_p.trace(), 0.0)) <= options_.max_partial_fix_sigma_m);
   return sub;
 }
@@ -993,10 +1063,7 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
         if (imprecise) {
           // The most precise combinations are fixed, but not enough of them to call the position fixed: the float
           // position conditioned on them is still the better one.
-          const Eigen::LLT<Eigen::MatrixXd> llt(imprecise->Q_a);
-          const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = imprecise->PDt.topRows<3>();
-          out.solution.p_E_m = x_.head<3>() - PDt_p * llt.solve(imprecise->a_float - imprecise->a_fix);
-          out.solution.P_E_m2 = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
+          (void)fix_position(*imprecise, out.solution.p_E_m, out.solution.P_E_m2);  // Q_a factorised already
           out.note += "; float position conditioned on " + std::to_string(imprecise->a_fix.size()) +
                       " fixed integer combinations";
         }
@@ -1005,18 +1072,14 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
       out.solution.ratio = std::min(best->ratio, 999.9);
     }
   }
-  // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix).
-  const Eigen::LLT<Eigen::MatrixXd> llt(best->Q_a);
-  if (llt.info() != Eigen::Success) {
+  // Conditional update on the fixed DD ambiguities: x_fix = x - P D^T Q_a^-1 (a_float - a_fix), the position rows.
+  if (!fix_position(*best, out.solution.p_E_m, out.solution.P_E_m2)) {
     out.note = "float ambiguity covariance not positive definite";
     return false;
   }
-  // Only the position block is output: its rows of P D^T suffice (the whole x_fix, P_fix would cost n^2 nd).
-  const Eigen::Matrix<double, 3, Eigen::Dynamic> PDt_p = best->PDt.topRows<3>();
-  out.solution.p_E_m = x_.head<3>() - PDt_p * llt.solve(best->a_float - best->a_fix);
-  out.solution.P_E_m2 = P_.topLeftCorner<3, 3>() - PDt_p * llt.solve(PDt_p.transpose());
   out.solution.status = core::SolutionStatus::Fixed;
   out.num_fixed_ambiguities = static_cast<int>(best->a_fix.size());
+  out.ar_pruned = best->pruned;
   // The integers of the DD ambiguities, for the next fixes to agree with (combinations fix no DD ambiguity as such).
   last_fix_.clear();
   if (!best->combinations) {
@@ -1036,23 +1099,34 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   return true;
 }
 
-Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding) {
   // The rover's satellite states are computed once, for the single-point solution, and reused by the zero
   // differences.
+  has_prior_ = false;
+  if (aiding != nullptr && !initialised_) aiding = nullptr;  // nothing to add the increment to yet
   gnss::EpochSatelliteStates rover_states(eph_, rover.time);
   auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_, &rover_states);
-  if (!spp) return spp.error();
-  last_spp_p_E_m_ = spp->p_E_m;
+  if (!spp && aiding == nullptr) return spp.error();
 
   RtkEpoch out;
   core::Solution& sol = out.solution;
-  sol.time = spp->time;
-  sol.status = core::SolutionStatus::Single;
-  sol.p_E_m = spp->p_E_m;
-  sol.P_E_m2 = spp->P_E_m2;
-  sol.v_E_mps = spp->v_E_mps;
-  sol.num_satellites = spp->num_satellites;
-  out.hdop = spp->dop.hdop;
+  if (spp) {
+    last_spp_p_E_m_ = spp->p_E_m;
+    sol.time = spp->time;
+    sol.status = core::SolutionStatus::Single;
+    sol.p_E_m = spp->p_E_m;
+    sol.P_E_m2 = spp->P_E_m2;
+    sol.v_E_mps = spp->v_E_mps;
+    sol.num_satellites = spp->num_satellites;
+    out.hdop = spp->dop.hdop;
+  } else if (aiding != nullptr) {
+    // Aided: the prior stands in for the single-point solution.
+    sol.time = rover.time;
+    sol.status = core::SolutionStatus::None;
+    sol.p_E_m = x_.head<3>() + aiding->delta_p_E_m;
+    sol.P_E_m2 = P_.topLeftCorner<3, 3>() + aiding->Q_E_m2;
+    out.note = "no single-point solution: " + spp.error().message;
+  }
   if (base == nullptr) {
     out.note = "no base observations";
     return out;
@@ -1065,22 +1139,42 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   }
 
   if (options_.ar_mode == ArMode::Instantaneous) clear_ambiguities();
-  choose_ionosphere_model((spp->p_E_m - p_E_base_m_).norm());
-  time_update(rover.time, *spp);
+  choose_ionosphere_model((sol.p_E_m - p_E_base_m_).norm());  // single-point position, or the aided prior
+  if (aiding != nullptr) {
+    aided_time_update(rover.time, *aiding);
+  } else {
+    time_update(rover.time, *spp);
+  }
   const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
   const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
   detect_slips(rover_obs, base_obs);
   std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs, rover_states);
   update_ambiguities(sds, rover.time);
+  if (aiding != nullptr) {
+    out.aided = true;
+    out.prior_p_E_m = x_.head<3>();
+    out.prior_P_E_m2 = P_.topLeftCorner<3, 3>();
+    prior_x_ = x_;
+    prior_P_ = P_;
+    prior_last_fix_ = last_fix_;
+    has_prior_ = true;
+  }
+  aiding_ = aiding;
+  last_code_rows_ = 0;
   bool consistent = true;
   out.num_dd_measurements = measurement_update(sds, out.rejected, consistent);
+  out.max_post_fit_normalised = last_post_fit_normalised_;
+  out.num_dd_code_measurements = last_code_rows_;
   if (out.num_dd_measurements == 0) {
+    aiding_ = nullptr;
     out.note = "no double-differenced phase";
     return out;
   }
   sol.status = core::SolutionStatus::Float;
   sol.p_E_m = x_.head<3>();
   sol.P_E_m2 = P_.topLeftCorner<3, 3>();
+  out.float_p_E_m = sol.p_E_m;
+  out.float_P_E_m2 = sol.P_E_m2;
   int satellites = 0;
   for (std::size_t i = 0; i < sds.size(); ++i) {
     if (sds[i].frequency == 0 || (i > 0 && sds[i - 1].sat != sds[i].sat)) ++satellites;
@@ -1095,6 +1189,7 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
     return out;
   }
   if (options_.ar_mode != ArMode::Off) resolve_ambiguities(sds, out);
+  aiding_ = nullptr;
   return out;
 }
 

@@ -152,8 +152,13 @@ Status write_simulation(const Simulation& sim, const std::string& dir) {
   if (Status s = write_truth(sim, (d / "truth.csv").string()); !s) return s;
   if (Status s = write_city(sim, (d / "city.geojson").string()); !s) return s;
   if (!sim.scenario.vio.enabled) return Ok{};
-  if (Status s = write_vio(sim.vio, (d / "vio.csv").string()); !s) return s;
-  return write_timesync(sim.vio, (d / "timesync.csv").string());
+  return write_vio_files(sim.vio, dir);
+}
+
+Status write_vio_files(const VioRun& vio, const std::string& dir) {
+  const std::filesystem::path d(dir);
+  if (Status s = write_vio(vio, (d / "vio.csv").string()); !s) return s;
+  return write_timesync(vio, (d / "timesync.csv").string());
 }
 
 }  // namespace canyon::sim

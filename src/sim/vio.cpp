@@ -2,6 +2,7 @@
 
 #include "canyon/sim/vio.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "canyon/core/constants.hpp"
@@ -11,37 +12,8 @@ namespace canyon::sim {
 namespace {
 
 constexpr std::uint64_t kVioStream = 0x710, kSyncStream = 0x5C;
-constexpr double kSmallAngleRad = 1e-9;
 constexpr double kInitialPositionVarM2 = 1e-8;
 constexpr double kInitialAngleVarRad2 = 1e-10;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
-/// Left Jacobian of SO(3), V(phi) of the SE(3) exponential.
-Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi) {
-  const double theta = phi.norm();
-  const Eigen::Matrix3d k = skew(phi);
-  if (theta < kSmallAngleRad) return Eigen::Matrix3d::Identity() + 0.5 * k;
-  const double t2 = theta * theta;
-  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * k +
-         (theta - std::sin(theta)) / (t2 * theta) * k * k;
-}
-
-Eigen::Quaterniond so3_exp(const Eigen::Vector3d& phi) {
-  const double theta = phi.norm();
-  if (theta < kSmallAngleRad) return Eigen::Quaterniond(1.0, 0.5 * phi.x(), 0.5 * phi.y(), 0.5 * phi.z()).normalized();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(theta, phi / theta));
-}
-
-Eigen::Vector3d so3_log(const Eigen::Quaterniond& q) {
-  const Eigen::AngleAxisd aa(q.normalized());
-  const double angle = aa.angle() > core::kPi ? aa.angle() - 2.0 * core::kPi : aa.angle();
-  return angle * aa.axis();
-}
 
 /// Device clock reading (ns) at `t_s` seconds after the start.
 double device_ns(const VioOptions& o, double t_s) {
@@ -71,27 +43,6 @@ Matrix6d step_noise(const VioOptions& o, double distance_m) {
 
 }  // namespace
 
-Pose se3_exp(const Vector6d& xi) {
-  const Eigen::Vector3d phi = xi.tail<3>();
-  return {so3_exp(phi), so3_left_jacobian(phi) * xi.head<3>()};
-}
-
-Vector6d se3_log(const Pose& T) {
-  const Eigen::Vector3d phi = so3_log(T.q);
-  Vector6d xi;
-  xi << so3_left_jacobian(phi).inverse() * T.p, phi;
-  return xi;
-}
-
-Matrix6d se3_adjoint(const Pose& T) {
-  const Eigen::Matrix3d R = T.q.toRotationMatrix();
-  Matrix6d ad = Matrix6d::Zero();
-  ad.topLeftCorner<3, 3>() = R;
-  ad.topRightCorner<3, 3>() = skew(T.p) * R;
-  ad.bottomRightCorner<3, 3>() = R;
-  return ad;
-}
-
 Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s) {
   const Eigen::Vector2d h = trajectory.heading_N(t_s);
   Eigen::Matrix3d R_NI;
@@ -101,18 +52,10 @@ Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s) {
   return R_NI;
 }
 
-VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std::uint64_t seed) {
-  const VioOptions& o = scenario.vio;
+VioRun simulate_vio_along(const VioOptions& o, const core::GpsTime& start, double duration_s,
+                          const std::function<Pose(double)>& T_OI_true, const Pose& T_EO, std::uint64_t seed) {
   VioRun run;
-  // T_EO: O is the city ENU frame rotated by the odometry yaw, at the IMU's start position.
-  const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(scenario.origin).transpose();
-  const Eigen::Vector3d origin_E = core::geodetic_to_ecef(scenario.origin);
-  const Pose T_NO{Eigen::Quaterniond(Eigen::AngleAxisd(o.odometry_yaw_deg * core::kDegToRad, Eigen::Vector3d::UnitZ())),
-                  body_pose_N(trajectory, o.t_IA_m, 0.0).p};
-  const Pose T_EN{Eigen::Quaterniond(R_EN), origin_E};
-  run.T_EO = T_EN * T_NO;
-  const Pose T_ON = T_NO.inverse();
-
+  run.T_EO = T_EO;
   Rng rng = Rng::stream(seed, kVioStream);
   const double first_ns = std::ceil(device_ns(o, 0.0));
   const double step_ns = 1e9 / o.rate_hz;
@@ -123,11 +66,11 @@ VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std:
   for (int k = 0;; ++k) {
     const double t_ns = first_ns + std::round(k * step_ns);
     const double t_s = true_seconds(o, t_ns);
-    if (t_s > scenario.duration_s) break;
+    if (t_s > duration_s) break;
     VioSample s;
     s.t_ns = static_cast<std::int64_t>(t_ns);
-    s.time = scenario.start + t_s;
-    s.T_OI_true = T_ON * body_pose_N(trajectory, o.t_IA_m, t_s);
+    s.time = start + t_s;
+    s.T_OI_true = T_OI_true(t_s);
     if (k == 0) {
       estimate = s.T_OI_true;
     } else {
@@ -135,8 +78,12 @@ VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std:
       const Matrix6d Q = step_noise(o, dT.p.norm());
       Vector6d n;
       for (int i = 0; i < 6; ++i) n(i) = std::sqrt(Q(i, i)) * rng.normal();
-      estimate = estimate * dT * se3_exp(n);
-      const Matrix6d A = se3_adjoint(dT.inverse());
+      const Pose dT_estimate = dT * se3_exp(n);
+      estimate = estimate * dT_estimate;
+      // Propagated with the VIO's own (estimated) increment, as a VIO filter does: the reported covariances are then
+      // consistent with the reported poses, which matters when a user differences absolute covariances of metres^2 to
+      // get an increment's of millimetres^2 (A from the true increment differs by the increment's noise).
+      const Matrix6d A = se3_adjoint(dT_estimate.inverse());
       s.cross_previous = P * A.transpose();
       P = A * P * A.transpose() + Q;
     }
@@ -146,13 +93,59 @@ VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std:
     run.poses.push_back(s);
   }
   Rng sync_rng = Rng::stream(seed, kSyncStream);
-  for (int second = 0; second <= static_cast<int>(std::floor(scenario.duration_s)); ++second) {
+  // Time-sync pairs at every whole GPST second of the span.
+  const double first_second = std::ceil(start.tow_s) - start.tow_s;
+  for (int i = 0; first_second + i <= duration_s; ++i) {
+    const double t_s = first_second + i;
     TimeSyncSample t;
-    t.time = scenario.start + static_cast<double>(second);
-    t.t_ns = std::llround(device_ns(o, second) + o.timesync_jitter_s * 1e9 * sync_rng.normal());
+    t.time = start + t_s;
+    t.t_ns = std::llround(device_ns(o, t_s) + o.timesync_jitter_s * 1e9 * sync_rng.normal());
     run.timesync.push_back(t);
   }
   return run;
+}
+
+VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std::uint64_t seed) {
+  const VioOptions& o = scenario.vio;
+  // T_EO: O is the city ENU frame rotated by the odometry yaw, at the IMU's start position.
+  const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(scenario.origin).transpose();
+  const Eigen::Vector3d origin_E = core::geodetic_to_ecef(scenario.origin);
+  const Pose T_NO{Eigen::Quaterniond(Eigen::AngleAxisd(o.odometry_yaw_deg * core::kDegToRad, Eigen::Vector3d::UnitZ())),
+                  body_pose_N(trajectory, o.t_IA_m, 0.0).p};
+  const Pose T_EN{Eigen::Quaterniond(R_EN), origin_E};
+  const Pose T_ON = T_NO.inverse();
+  return simulate_vio_along(
+      o, scenario.start, scenario.duration_s, [&](double t_s) { return T_ON * body_pose_N(trajectory, o.t_IA_m, t_s); },
+      T_EN * T_NO, seed);
+}
+
+VioRun simulate_vio_from_truth(const VioOptions& o, const std::vector<SixDofSample>& truth, std::uint64_t seed) {
+  const auto T_EI_at = [&](double t_s) {
+    const core::GpsTime t = truth.front().time + t_s;
+    auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                               [](const SixDofSample& s, const core::GpsTime& when) { return s.time - when < 0.0; });
+    if (it == truth.begin()) ++it;
+    if (it == truth.end()) --it;
+    const SixDofSample& b = *it;
+    const SixDofSample& a = *(it - 1);
+    const double span = b.time - a.time;
+    const double x = span > 0.0 ? (t - a.time) / span : 0.0;
+    const Eigen::Vector3d p_E_A = a.p_E_A_m + x * (b.p_E_A_m - a.p_E_A_m);
+    const Eigen::Quaterniond q = a.q_EI.slerp(x, b.q_EI).normalized();
+    return Pose{q, p_E_A - (q * o.t_IA_m)};
+  };
+  const Pose T_EI_0 = T_EI_at(0.0);
+  const core::Geodetic g = core::ecef_to_geodetic(T_EI_0.p);
+  const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(g).transpose();
+  const Pose T_EO{
+      Eigen::Quaterniond(
+          R_EN * Eigen::AngleAxisd(o.odometry_yaw_deg * core::kDegToRad, Eigen::Vector3d::UnitZ()).toRotationMatrix())
+          .normalized(),
+      T_EI_0.p};
+  const Pose T_OE = T_EO.inverse();
+  const double duration_s = truth.back().time - truth.front().time;
+  return simulate_vio_along(
+      o, truth.front().time, duration_s, [&](double t_s) { return T_OE * T_EI_at(t_s); }, T_EO, seed);
 }
 
 }  // namespace canyon::sim

@@ -39,6 +39,59 @@ TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {
   ProcessConfig expected;
   expected.mode = ProcessMode::Rtk;
   EXPECT_EQ(to_yaml(*rtk), to_yaml(expected));
+  // config/fusion.yaml: every fusion key at its default; the rtk section sets what it says.
+  auto fusion = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/fusion.yaml");
+  ASSERT_TRUE(fusion.ok()) << fusion.error().to_string();
+  ProcessConfig expected_fusion;
+  expected_fusion.mode = ProcessMode::Fusion;
+  expected_fusion.rtk.ar_mode = rtk::ArMode::FixAndHold;
+  expected_fusion.rtk.ionosphere = rtk::IonosphereModel::Estimate;
+  EXPECT_EQ(to_yaml(*fusion), to_yaml(expected_fusion));
+}
+
+TEST(ProcessConfigTest, FusionOptionsParseValidateAndRoundTrip) {
+  auto config = parse(R"(
+mode: fusion
+base: base.obs
+vio: vio.csv
+timesync: sync/timesync.csv
+fusion: {gate: chi_square, prediction: constant_velocity, lever_arm_prior_m: [0.1, 0, 0.12], alignment_max_rmse_m: 0.05,
+         vio_clock: gps, cn0_screen: true, false_fix_guard: false}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(config->mode, ProcessMode::Fusion);
+  EXPECT_EQ(config->vio, "vio.csv");
+  EXPECT_EQ(config->timesync, "sync/timesync.csv");
+  EXPECT_EQ(config->fusion.gate, fusion::InnovationGate::ChiSquare);
+  EXPECT_EQ(config->fusion.prediction, fusion::Prediction::ConstantVelocity);
+  EXPECT_DOUBLE_EQ(config->fusion.lever_arm_prior_m.z(), 0.12);
+  EXPECT_DOUBLE_EQ(config->fusion.alignment.max_rmse_m, 0.05);
+  EXPECT_TRUE(config->fusion.vio_on_gps_time);
+  EXPECT_TRUE(config->fusion.cn0.enabled);
+  EXPECT_FALSE(config->fusion.false_fix_guard);
+  auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+  // Unknown keys and bad values are errors naming the key.
+  for (const char* bad : {"fusion: {gate: sometimes}", "fusion: {prediction: imu}", "fusion: {alignment_max_fer: 2}",
+                          "fusion: {lever_arm_prior_m: [1, 2]}", "fusion: {vio_clock: utc}", "fusion: {ratio: 3}",
+                          "fusion: {alignment_max_rmse_m: -1}"}) {
+    const auto r = parse(bad);
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_NE(r.error().to_string().find("test.yaml"), std::string::npos) << r.error().to_string();
+  }
+  // What fusion needs.
+  ProcessConfig c;
+  c.mode = ProcessMode::Fusion;
+  c.rover_obs = "r.obs";
+  c.nav = {"n.nav"};
+  c.out = "x.pos";
+  c.base_obs = "b.obs";
+  EXPECT_NE(c.validate().find("VIO file"), std::string::npos) << c.validate();
+  c.vio = "vio.csv";
+  EXPECT_NE(c.validate().find("time-sync file"), std::string::npos) << c.validate();
+  c.fusion.vio_on_gps_time = true;
+  EXPECT_EQ(c.validate(), "");
 }
 
 TEST(ProcessConfigTest, RtkOptionsParseAndRoundTrip) {

@@ -33,13 +33,17 @@ TEST(DemoCli, SimulatesProcessesRunsRtklibAndEvaluates) {
   const std::size_t rtklib = r.output.find("RTKLIB");
   const std::size_t spp = r.output.find("canyon SPP");
   const std::size_t rtk = r.output.find("canyon RTK");
+  const std::size_t fusion = r.output.find("canyon fusion");
   ASSERT_NE(rtklib, std::string::npos) << r.output;
   ASSERT_NE(spp, std::string::npos) << r.output;
   ASSERT_NE(rtk, std::string::npos) << r.output;
+  ASSERT_NE(fusion, std::string::npos) << r.output;
   EXPECT_LT(rtklib, spp);
   EXPECT_LT(spp, rtk);
-  for (const char* name : {"scenario/rover.obs", "scenario/truth.csv", "scenario/city.geojson", "spp.pos", "rtk.pos",
-                           "rtklib.pos", "evaluation.md", "evaluation.json", "trajectory.svg", "ape.svg"}) {
+  EXPECT_LT(rtk, fusion);
+  for (const char* name :
+       {"scenario/rover.obs", "scenario/truth.csv", "scenario/city.geojson", "spp.pos", "rtk.pos", "fusion.pos",
+        "rtklib.pos", "evaluation.md", "evaluation.json", "trajectory.svg", "ape.svg"}) {
     EXPECT_TRUE(fs::exists(dir / name) && fs::file_size(dir / name) > 0) << name;
   }
   const std::string json = read_file(dir / "evaluation.json");

@@ -1,12 +1,13 @@
 #pragma once
 // `canyon demo`: canyon's main job on a built-in default, with no external data. Generates a scenario
-// (urban-severe unless told otherwise), processes it with every mode canyon has (SPP, RTK), runs RTKLIB's
+// (urban-severe unless told otherwise), processes it with every mode canyon has (SPP, RTK, fusion), runs RTKLIB's
 // `rnx2rtkp` on the same files as the baseline when it is installed, and scores everything against the scenario's
 // truth: the side-by-side table (RTKLIB : canyon) and the plots of `canyon evaluate`.
 //
 // Files (DIR):
 //   scenario/        the generated scenario (canyon simulate's files)
-//   spp.pos rtk.pos  canyon's solutions (configurations: the shipped spp defaults and config/<rtk_config>)
+//   spp.pos rtk.pos fusion.pos  canyon's solutions (configurations: the shipped spp defaults, config/<rtk_config>,
+//                    config/<fusion_config> with the scenario's vio.csv and timesync.csv)
 //   rtklib.pos       RTKLIB's solution (config/<rtklib_config>), rtklib.log its messages
 //   evaluation.md evaluation.json trajectory.svg ape.svg   canyon evaluate's outputs
 
@@ -27,6 +28,7 @@ struct DemoConfig {
   std::optional<double> duration_s;               ///< default: the scenario's
   std::string out_dir = "out/demo";               ///< created if needed
   std::string rtk_config = "rtk-urban.yaml";      ///< canyon's RTK configuration, a file in the shipped config/
+  std::string fusion_config = "fusion.yaml";      ///< canyon's fusion configuration, a file in the shipped config/
   std::string rtklib_config = "rtklib/sim.conf";  ///< RTKLIB's option file, in the shipped config/
   bool run_rtklib = true;                         ///< run `rnx2rtkp` (skipped with a note when not installed)
   std::string rtklib_program = "rnx2rtkp";        ///< found on PATH

@@ -23,6 +23,9 @@ struct ProcessSummary {
   /// Why epochs got no solution or one below the mode's best (first 100): "week tow: no solution: reason" or, in
   /// rtk mode, "week tow: float: ratio test failed" (status, then why it is not fixed).
   std::vector<std::string> epoch_notes;
+  /// Fusion: the time bridge, VIO segments, alignments, lever-arm calibration and its observability, float
+  /// validation and false-fix guard counts (one line each).
+  std::vector<std::string> report;
 };
 
 /// The `n` satellites of the constellations in `systems` tracked (any code or phase) in the most epochs, most

@@ -3,9 +3,11 @@
 // file and/or the command line. Relative paths in a YAML file are relative to that file's folder.
 //
 // YAML keys (all optional; the command line overrides them):
-//   mode: spp                      # processing mode: spp | rtk (fusion comes with a later module)
+//   mode: spp                      # processing mode: spp | rtk | fusion
 //   rover: ROVER.obs               # rover RINEX observations (2.x/3.x, may be .gz)
-//   base: BASE.obs                 # base RINEX observations (rtk)
+//   base: BASE.obs                 # base RINEX observations (rtk, fusion)
+//   vio: vio.csv                   # VIO poses (fusion; DESIGN.md contract, io/vio_file.hpp)
+//   timesync: timesync.csv         # the device's GPS time-sync pairs (fusion, unless fusion.vio_clock: gps)
 //   base_position: [X, Y, Z]       # base antenna ECEF (m); default: the base file's APPROX POSITION XYZ
 //   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
 //   out: SOL.pos                   # solution file (RTKLIB .pos format)
@@ -26,6 +28,7 @@
 //     qzss_own_clock: false        # false: QZSS shares the GPS receiver clock
 //     exclude: [G05]               # satellites never used
 //   rtk:                           # see config/rtk.yaml for every key with its unit and default
+//   fusion:                        # see config/fusion.yaml for every key with its unit and the paper's defaults
 
 #include <optional>
 #include <string>
@@ -34,18 +37,21 @@
 #include <yaml-cpp/yaml.h>
 
 #include "canyon/core/result.hpp"
+#include "canyon/fusion/fusion_engine.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/rtk/engine.hpp"
 
 namespace canyon::app {
 
-enum class ProcessMode { Spp, Rtk };
+enum class ProcessMode { Spp, Rtk, Fusion };
 
 struct ProcessConfig {
   ProcessMode mode = ProcessMode::Spp;
   std::string rover_obs;                             ///< rover observation file
-  std::string base_obs;                              ///< base observation file (rtk)
+  std::string base_obs;                              ///< base observation file (rtk, fusion)
+  std::string vio;                                   ///< VIO pose file (fusion)
+  std::string timesync;                              ///< time-sync file (fusion with a device clock)
   std::optional<Eigen::Vector3d> base_position_E_m;  ///< base antenna position (ECEF, m); header position if unset
   std::vector<std::string> nav;                      ///< navigation files
   std::string out;                                   ///< solution file
@@ -55,6 +61,7 @@ struct ProcessConfig {
   io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
   gnss::SppOptions spp;
   rtk::RtkOptions rtk;
+  fusion::FusionOptions fusion;
 
   /// Empty if complete and consistent, else the first violated rule ("rover observation file is required").
   [[nodiscard]] std::string validate() const;

@@ -42,6 +42,12 @@
 // single-point solution with a large variance; with dynamics a constant-acceleration model with white jerk.
 // Ambiguities carry over with a small random walk.
 //
+// External aiding (RtkAiding, per epoch; the VIO fusion of fusion/fusion_engine.hpp): the position's time update
+// becomes p += delta_p_E_m, P_pp += Q_E_m2 with its correlations to the ambiguities kept (an EKF prediction with the
+// external motion as the model); the epoch is solved even when the single-point solution fails; DD innovations are
+// also gated by the aiding's thresholds; a fix is accepted only if the aiding's accept_fix agrees; and the prior is
+// kept so that revert_to_prior() can undo the epoch's measurement update and ambiguity resolution.
+//
 // Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA; a fix is accepted when it passes
 // the ratio test, the bootstrapped success rate of the float covariance reaches min_success_rate (the ratio test
 // alone accepts wrong single-frequency, single-epoch fixes), and no DD ambiguity also fixed at the last fix (no slip
@@ -55,6 +61,7 @@
 // bootstrapped success rate reaches min_success_rate, when they pass the ratio test: while a float solution
 // converges, part of it is already determined. GLONASS ambiguities are fixed only when glonass_ar is on.
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -130,14 +137,36 @@ struct RtkOptions {
   [[nodiscard]] std::string validate() const;
 };
 
+/// Aiding of one epoch by an external motion sensor (see the model above).
+struct RtkAiding {
+  Eigen::Vector3d delta_p_E_m = Eigen::Vector3d::Zero();  ///< position increment since the state's last epoch (m)
+  Eigen::Matrix3d Q_E_m2 = Eigen::Matrix3d::Zero();       ///< its covariance, added to the position's (m^2)
+  std::optional<double> max_phase_innovation_m;           ///< DD phase innovations beyond are rejected (m)
+  std::optional<double> max_code_innovation_m;            ///< DD code innovations beyond are rejected (m)
+  std::optional<double> max_normalised_innovation;        ///< |v| / sqrt(h P h^T + r) beyond is rejected
+  /// A candidate fix's position and covariance; false rejects it. Empty: no check.
+  std::function<bool(const Eigen::Vector3d&, const Eigen::Matrix3d&)> accept_fix;
+};
+
 /// One epoch's result.
 struct RtkEpoch {
   core::Solution solution;                  ///< status Fixed, Float or Single
   int num_fixed_ambiguities = 0;            ///< DD ambiguities in the accepted fix (0 if not fixed)
   int num_dd_measurements = 0;              ///< DD phase measurements used in the update
+  int num_dd_code_measurements = 0;         ///< DD code measurements used in the update
   std::vector<core::SatelliteId> rejected;  ///< satellites whose measurements failed the innovation gate
   std::string note;                         ///< why the epoch is not fixed, if it is not (for --verbose)
   double hdop = 0.0;                        ///< of the single-point geometry, for NMEA GGA
+  // The float solution and the post-fit check of the update (also when a fix is output).
+  Eigen::Vector3d float_p_E_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d float_P_E_m2 = Eigen::Matrix3d::Zero();
+  double max_post_fit_normalised = 0.0;      ///< largest DD post-fit residual (phase or code) over its rejection
+                                             ///< threshold (max_post_fit_sigmas or _code_sigmas) after rejections
+  std::vector<core::SatelliteId> ar_pruned;  ///< satellites partial fixing pruned by their ILS residual
+  // Aided epochs: the prior (after the time update with the aiding).
+  bool aided = false;
+  Eigen::Vector3d prior_p_E_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d prior_P_E_m2 = Eigen::Matrix3d::Zero();
 };
 
 /// The RTK filter. Feed rover epochs in time order with the base epoch to use (nullptr if none).
@@ -145,8 +174,18 @@ class RtkEngine {
  public:
   RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides, Eigen::Vector3d p_E_base_m);
 
-  /// Processes one rover epoch. Error only if not even a single-point solution exists.
-  Result<RtkEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base);
+  /// Processes one rover epoch. Error only if not even a single-point solution exists (and, when aided, no prior).
+  Result<RtkEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding = nullptr);
+  /// Undoes the measurement update and the ambiguity resolution of the last process() call, which must have been
+  /// aided: the state goes back to that epoch's prior (ambiguities added or reset by slips that epoch stay).
+  void revert_to_prior();
+  /// GPST of the state: the last epoch whose time update ran; nullopt before the first.
+  [[nodiscard]] const std::optional<core::GpsTime>& state_time() const { return last_time_; }
+  /// Whether the position state holds an estimate (aiding needs one).
+  [[nodiscard]] bool has_position() const { return initialised_; }
+  /// The position state (float, ECEF) and its covariance at state_time().
+  [[nodiscard]] Eigen::Vector3d position_E_m() const { return x_.head<3>(); }
+  [[nodiscard]] Eigen::Matrix3d position_covariance_E_m2() const { return P_.topLeftCorner<3, 3>(); }
 
  private:
   // Keyed states after the kinematic block: (satellite, frequency rank) for an ambiguity, (satellite, kIonoKey) for
@@ -158,6 +197,8 @@ class RtkEngine {
     core::GpsTime last_seen;
   };
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
+  /// Time update with external aiding: p += delta, P_pp += Q, ambiguity random walks.
+  void aided_time_update(const core::GpsTime& t, const RtkAiding& aiding);
   /// `rover_states`: the rover epoch's satellite states (shared with its single-point solution).
   [[nodiscard]] std::vector<SingleDiff> single_differences(const ReceiverObservables& rover,
                                                            const ReceiverObservables& base,
@@ -191,8 +232,9 @@ class RtkEngine {
     Eigen::MatrixXd PDt;    // P D^T
     Eigen::VectorXd a_fix;  // best integer candidate
     double ratio = 0.0;
-    double squared_norm = 0.0;  // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
-    double success_rate = 0.0;  // bootstrapped success rate of the float model
+    double squared_norm = 0.0;              // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
+    double success_rate = 0.0;              // bootstrapped success rate of the float model
+    std::vector<core::SatelliteId> pruned;  // satellites pruned by their ILS residual to get this set
     // The fixed quantities are integer combinations Z_S^T of the DD ambiguities dd (a_float = Z_S^T D x, PDt = P D^T
     // Z_S) rather than the DD ambiguities themselves: a partial fix by the success rate.
     bool combinations = false;
@@ -208,10 +250,12 @@ class RtkEngine {
   /// when the position it leaves has a 3D sigma above max_partial_fix_sigma_m (then it is no fix, but the float
   /// position conditioned on it is still the better float).
   [[nodiscard]] std::optional<Fix> success_rate_subset_fix(const Fix& full, int min_size) const;
-  /// Ratio test, success rate and agreement with the last fix.
+  /// Ratio test, success rate and agreement with the last fix (and the aiding's accept_fix when aided).
   [[nodiscard]] bool accepted(const Fix& fix) const;
   /// Why a fix is not accepted, with its figures (for --verbose).
   [[nodiscard]] std::string rejection_reason(const Fix& fix) const;
+  /// Position and its covariance of a candidate fix (conditional update); false if Q_a is not positive definite.
+  [[nodiscard]] bool fix_position(const Fix& fix, Eigen::Vector3d& p, Eigen::Matrix3d& P) const;
   /// A DD ambiguity by the keys of its two SD ambiguities (satellite s, reference satellite).
   using DdKey = std::pair<AmbiguityKey, AmbiguityKey>;
   [[nodiscard]] DdKey dd_key(const std::pair<int, int>& dd) const;
@@ -260,6 +304,14 @@ class RtkEngine {
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;
   std::map<DdKey, double> last_fix_;  // integers of the last accepted fix; pairs leave with their ambiguities
+  // Aiding of the epoch being processed (nullptr otherwise), and the prior kept for revert_to_prior().
+  const RtkAiding* aiding_ = nullptr;
+  bool has_prior_ = false;
+  Eigen::VectorXd prior_x_;
+  Eigen::MatrixXd prior_P_;
+  std::map<DdKey, double> prior_last_fix_;
+  double last_post_fit_normalised_ = 0.0;
+  int last_code_rows_ = 0;
   static constexpr int kFullSetRetryEpochs = 10;
   std::vector<DdKey> failed_full_set_;  // the full DD set whose integer search last failed (empty: none)
   int epochs_since_full_set_ = 0;       // epochs since the full set was last searched

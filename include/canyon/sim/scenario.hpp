@@ -147,16 +147,16 @@ struct ConstellationOptions : core::ConstellationFlags {
 
 /// The head-worn device's visual-inertial odometry and clock (see vio.hpp).
 struct VioOptions {
-  bool enabled = true;                     ///< write vio.csv and timesync.csv
-  Eigen::Vector3d t_IA_m{0.0, 0.0, 0.12};  ///< antenna position in the IMU frame (lever arm) (m)
-  double odometry_yaw_deg = 30.0;          ///< yaw of the odometry frame O from east, counter-clockwise (deg)
-  double rate_hz = 10.0;                   ///< VIO pose rate, device clock (Hz)
-  double position_drift_fraction = 0.004;  ///< 1-sigma 3-D translation random walk after 1 km, per distance
-  double yaw_drift_deg_per_km = 0.3;       ///< 1-sigma heading random walk after 1 km walked (deg)
-  double tilt_drift_deg_per_km = 0.02;     ///< 1-sigma roll and pitch random walk after 1 km walked (deg)
-  double device_clock_offset_s = 1234.5;   ///< device clock reading at the scenario start (s)
-  double device_clock_drift_ppm = 20.0;    ///< device clock rate error (1e-6)
-  double timesync_jitter_s = 0.0005;       ///< noise of the built-in GPS time-sync pairs, 1 sigma (s)
+  bool enabled = true;                      ///< write vio.csv and timesync.csv
+  Eigen::Vector3d t_IA_m{0.0, 0.0, 0.12};   ///< antenna position in the IMU frame (lever arm) (m)
+  double odometry_yaw_deg = 30.0;           ///< yaw of the odometry frame O from east, counter-clockwise (deg)
+  double rate_hz = 10.0;                    ///< VIO pose rate, device clock (Hz)
+  double position_drift_fraction = 0.0005;  ///< 1-sigma 3-D translation random walk after 1 km, per distance
+  double yaw_drift_deg_per_km = 0.5;        ///< 1-sigma heading random walk after 1 km walked (deg)
+  double tilt_drift_deg_per_km = 0.02;      ///< 1-sigma roll and pitch random walk after 1 km walked (deg)
+  double device_clock_offset_s = 1234.5;    ///< device clock reading at the scenario start (s)
+  double device_clock_drift_ppm = 20.0;     ///< device clock rate error (1e-6)
+  double timesync_jitter_s = 0.0005;        ///< noise of the built-in GPS time-sync pairs, 1 sigma (s)
 };
 
 struct Scenario {

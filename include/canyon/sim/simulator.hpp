@@ -113,4 +113,7 @@ Result<Simulation> simulate(const Scenario& scenario, const std::string& nav_pat
 /// files depend on the scenario only.
 Status write_simulation(const Simulation& simulation, const std::string& dir);
 
+/// Writes vio.csv and timesync.csv of a VIO run into `dir` (which must exist).
+Status write_vio_files(const VioRun& vio, const std::string& dir);
+
 }  // namespace canyon::sim

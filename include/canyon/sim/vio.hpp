@@ -14,10 +14,18 @@
 //   Q_k = d_k / 1000 m * diag(s_p^2, s_p^2, s_p^2, s_t^2, s_t^2, s_y^2),
 // d_k the distance walked in the step, s_p = position_drift_fraction * 1000 m / sqrt(3) (per axis, so that the 3-D
 // translation random walk is position_drift_fraction of 1 km after 1 km), s_y, s_t the heading and tilt random walks
-// after 1 km. The heading error bends the path, so the position drift grows faster than sqrt(distance); with the
-// defaults (0.4 %, 0.3 deg) the 1-sigma 3-D error after a straight kilometre is about 0.5 % of it. The reported
+// after 1 km. The heading error bends the path, so the position drift grows faster than sqrt(distance): as
+// distance^1.5, smoothly, while the translation random walk grows as sqrt(distance) with the same jitter at every
+// frame. Real VIO drifts mostly in heading and scale and is millimetre-accurate from one frame to the next, so the
+// defaults put the drift in the heading (0.5 deg after 1 km) and keep the translation random walk small (0.05 %):
+// the 1-sigma 3-D error after a straight kilometre is 0.5 % of it (5 m), after 10 m of walk about 5 cm, and from
+// one 0.1 s frame to the next 3 mm per axis. (A translation random walk of 0.4 % alone would also give 0.5 % after
+// 1 km, but 2.7 cm of jitter per axis between consecutive 10 Hz frames, far beyond any VIO.) The reported
 // covariance is propagated to first order:
-//   P_k = A_k P_k-1 A_k^T + Q_k,   A_k = Ad(dT_k^-1),   cov(xi_k-1, xi_k) = P_k-1 A_k^T,
+//   P_k = A_k P_k-1 A_k^T + Q_k,   A_k = Ad(dT_est,k^-1),   cov(xi_k-1, xi_k) = P_k-1 A_k^T,
+// with the VIO's estimated increment dT_est,k = dT_k Exp(n_k), as a VIO filter propagates (first order, the same as
+// with dT_k; but consistent with the reported poses, so that a consumer chaining the covariances with the reported
+// relative motions, fusion/vio_track.hpp, gets the increments' small covariances right),
 // with Ad(T) = [[R, [t]x R], [0, R]] for the [translation; rotation] ordering; P_0 = diag(1e-8 m^2 x 3,
 // 1e-10 rad^2 x 3) (O is defined by the first pose).
 //
@@ -26,35 +34,28 @@
 // Gaussian jitter.
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/se3.hpp"
 #include "canyon/core/time.hpp"
 #include "canyon/sim/route.hpp"
 #include "canyon/sim/scenario.hpp"
 
 namespace canyon::sim {
 
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-
-/// A rigid transform (rotation and translation) in SE(3).
-struct Pose {
-  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-
-  [[nodiscard]] Pose operator*(const Pose& b) const { return {q * b.q, p + q * b.p}; }
-  [[nodiscard]] Pose inverse() const { return {q.conjugate(), -(q.conjugate() * p)}; }
-};
-
-/// SE(3) exponential and logarithm for xi = [translation part; rotation vector].
-[[nodiscard]] Pose se3_exp(const Vector6d& xi);
-[[nodiscard]] Vector6d se3_log(const Pose& T);
-/// Adjoint of T for the [translation; rotation] ordering: Exp(Ad(T) xi) = T Exp(xi) T^-1.
-[[nodiscard]] Matrix6d se3_adjoint(const Pose& T);
+// The SE(3) maths (Pose, Exp/Log, adjoint, [translation; rotation] ordering, right perturbation) is canyon's one copy
+// in core/se3.hpp.
+using core::Matrix6d;
+using core::Pose;
+using core::se3_adjoint;
+using core::se3_exp;
+using core::se3_log;
+using core::Vector6d;
 
 struct VioSample {
   std::int64_t t_ns = 0;                       ///< device clock
@@ -79,6 +80,28 @@ struct VioRun {
 /// The device's VIO and time sync along the rover trajectory of `scenario` (its city origin and start time). The
 /// same seed gives the same run.
 [[nodiscard]] VioRun simulate_vio(const Scenario& scenario, const Trajectory& trajectory, std::uint64_t seed);
+
+/// The VIO of any true body motion: `T_OI_true(t_s)` is the true IMU pose in the odometry frame `T_EO` at t_s
+/// seconds after `start`, for t_s in [0, duration_s]; poses and time sync as simulate_vio() makes them (same clock,
+/// drift and covariance model, same random streams).
+[[nodiscard]] VioRun simulate_vio_along(const VioOptions& options, const core::GpsTime& start, double duration_s,
+                                        const std::function<Pose(double)>& T_OI_true, const Pose& T_EO,
+                                        std::uint64_t seed);
+
+/// One sample of a 6-DoF ground truth: the antenna position and the body attitude R_EI (I: x forward, y left,
+/// z up).
+struct SixDofSample {
+  core::GpsTime time;
+  Eigen::Vector3d p_E_A_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_EI = Eigen::Quaterniond::Identity();
+};
+
+/// The VIO of a device carried along a recorded 6-DoF truth (`canyon simulate --vio-from-truth`): the IMU at
+/// p_E_A - R_EI t_IA (options.t_IA_m), O gravity-aligned (ENU at the first sample rotated by odometry_yaw_deg) with
+/// its origin at the IMU's first position; truth interpolated linearly in position and on SO(3) in attitude. Pose
+/// times span the truth's. Samples must be in time order, at least two.
+[[nodiscard]] VioRun simulate_vio_from_truth(const VioOptions& options, const std::vector<SixDofSample>& truth,
+                                             std::uint64_t seed);
 
 /// Body attitude R_NI at time t_s (seconds since the start): level, x along the walking direction.
 [[nodiscard]] Eigen::Matrix3d body_attitude_N(const Trajectory& trajectory, double t_s);

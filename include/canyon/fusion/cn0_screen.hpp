@@ -1,0 +1,59 @@
+#pragma once
+// NLOS screening by C/N0 (beyond the paper). A signal received only by reflection (NLOS) arrives weaker than a
+// line-of-sight signal from the same elevation: the reflection loses power (typically 10 dB or more off a wall).
+// Its code and phase then carry the full excess path, which neither the innovation gates nor the ratio test see
+// reliably once the filter has drifted with it. The screen learns the line-of-sight level of the rover's receiver
+// from the data, as a high quantile of the C/N0 seen so far per (constellation, band, elevation bin), and removes
+// the signals more than margin_db below that level before the update.
+//
+//   level(system, band, bin) = quantile q of the C/N0 histogram (0.5 dB bins) of the signals seen in that bin so far;
+//   a signal is screened out if its bin has at least min_samples signals and C/N0 < level - margin_db.
+// Elevations come from the broadcast orbits and the receiver's approximate position. The learning is causal (each
+// epoch's signals are added after the epoch is screened), so the batch and real-time runs agree.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/observation.hpp"
+#include "canyon/gnss/ephemeris.hpp"
+
+namespace canyon::fusion {
+
+struct Cn0ScreenOptions {
+  bool enabled = true;
+  double margin_db = 7.0;  ///< screened when this far below the learnt line-of-sight level (dB)
+  double quantile = 0.9;   ///< the learnt level: this quantile of the C/N0 in the bin (0..1)
+  double bin_deg = 5.0;    ///< elevation bin width (deg)
+  int min_samples = 50;    ///< bins with fewer signals screen nothing yet
+
+  [[nodiscard]] std::string validate() const;
+};
+
+class Cn0Screen {
+ public:
+  explicit Cn0Screen(Cn0ScreenOptions options);
+
+  /// Removes the suspected NLOS signals from `epoch` (a satellite left without signals is removed), then learns from
+  /// the epoch's signals. Returns the number of signals removed.
+  int apply(core::ObsEpoch& epoch, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_approx_m);
+
+  /// The learnt line-of-sight level (dB-Hz) of a bin, or a negative value if it has too few samples.
+  [[nodiscard]] double level_dbhz(core::Constellation system, char band, double elevation_rad) const;
+
+ private:
+  static constexpr int kHistogramBins = 140;    // 0.5 dB from 0 to 70 dB-Hz
+  static constexpr int kMaxElevationBins = 90;  // up to 1-degree bins
+  struct Histogram {
+    std::array<int, kHistogramBins> counts{};
+    int total = 0;
+  };
+  [[nodiscard]] int key(core::Constellation system, char band, double elevation_rad) const;
+
+  Cn0ScreenOptions options_;
+  std::vector<Histogram> histograms_;
+};
+
+}  // namespace canyon::fusion

@@ -1,0 +1,210 @@
+#pragma once
+// The paper's per-epoch fusion (Algorithm 1) on canyon's RTK engine.
+//
+// For each rover epoch i+1 at GPST t:
+//  1. VIO pose at t (VioTrack, interpolated on SE(3)); a gap or a new VIO segment (reset) drops the alignment of the
+//     old segment: the engine falls back to its own motion model until a window of the new segment aligns.
+//  2. Alignment (alignment.hpp): until the first alignment, every alignment_interval_s, the last alignment_window_s
+//     of RTK solutions (fixed or float, position sigma <= max_window_sigma_m) of the VIO segment are fitted with the
+//     paper's two passes (T_EO from identity with t_IA = 0, then T_EO and t_IA jointly); the window qualifies when
+//     its FER < 0.97 and the fit RMSE < 0.1 m. Afterwards every realign_interval_s a window of fixed solutions
+//     refreshes T_EO with t_IA held (the VIO drifts). Beyond the paper, while no window qualifies, a coarse
+//     gravity-aligned yaw fit of the last coarse_window_s of any RTK solutions, with its yaw uncertainty carried into
+//     the prediction, aligns the VIO (coarse_alignment).
+//  3. Prediction (vio_prediction.hpp, Eqs. 3-6): the engine's position state moves by dp_E = R_EO dp_O of the
+//     antenna's VIO increment since the state's epoch, its covariance grows by R_EO cov(dp_O) R_EO^T, ambiguities
+//     carry over (rtk::RtkAiding). Without an alignment: the engine's own time update (single point or dynamics).
+//  4. Outlier satellite pruning in the update: DD phase innovations beyond gate_motion_factor x |dp_E| (the paper: 5x
+//     the VIO incremental motion, at least min_gate_m; applied to phase only: DD code noise is of that size) and/or
+//     DD phase and code innovations beyond gate_sigmas sqrt(h P h^T + r) (chi-square gate).
+//  Beyond the paper, before all that, the C/N0 screen (cn0_screen.hpp) removes suspected NLOS signals of aided epochs
+//  (it learns from all: before the alignment the RTK engine needs every signal for the solutions it aligns with).
+//  5. Float validation: at least one DD phase used; the largest DD post-fit residual, over the RTK engine's rejection
+//     threshold, <= max_post_fit_normalised; the float position consistent with the prior,
+//     (p_float - p_prior)^T P_prior^-1 (p_float - p_prior) <= max_prior_chi2. If it fails: the update is undone and
+//     the epoch's output is the prior (aligned VIO fill-in, Q = 7). Beyond the paper, two recoveries from a prior
+//     that drifted (a poor alignment, a long fill-in): after max_prior_rejections consecutive epochs failing only the
+//     prior check, the float is taken; after gate_conflict_epochs consecutive epochs whose gates rejected more rows
+//     than the update used, the next prior's position sigma is widened by reanchor_sigma_m.
+//  6. MLAMBDA with the ratio test (rtk options, 3.0); when it fails the engine prunes the satellite with the largest
+//     integer least-squares residual and solves again (Algorithm 1, lines 13-19; rtk partial_ar). Beyond the paper,
+//     a false-fix guard rejects a candidate fix whose position disagrees with the prior:
+//     (p_fix - p_prior)^T (P_prior + P_fix)^-1 (p_fix - p_prior) > false_fix_chi2, and a fix whose position sigma
+//     (largest axis of P_fix) exceeds max_fix_sigma_m (integers fixed, position not: three satellites).
+//  7. Output: fixed, else float (Algorithm 1).
+// Prediction "constant_velocity" (an ablation) replaces the VIO increment by v dt from the last two fixed or float
+// solutions (none if they are more than 5 s apart or imply more than vio_max_speed_mps), with covariance
+// (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/observation.hpp"
+#include "canyon/core/result.hpp"
+#include "canyon/core/solution.hpp"
+#include "canyon/fusion/alignment.hpp"
+#include "canyon/fusion/cn0_screen.hpp"
+#include "canyon/fusion/time_bridge.hpp"
+#include "canyon/fusion/vio_track.hpp"
+#include "canyon/gnss/ephemeris.hpp"
+#include "canyon/rtk/engine.hpp"
+
+namespace canyon::fusion {
+
+enum class Prediction { Vio, ConstantVelocity };
+enum class InnovationGate { Off, Paper, ChiSquare, Both };
+
+[[nodiscard]] const char* prediction_name(Prediction p);
+[[nodiscard]] const char* innovation_gate_name(InnovationGate g);
+
+struct FusionOptions {
+  bool vio_on_gps_time = false;  ///< vio.csv t_ns is GPST ns since 1980-01-06 (no time-sync file needed)
+  TimeBridgeOptions time_sync;
+  VioTrackOptions vio;
+  AlignmentOptions alignment;         ///< FER 0.97, RMSE 0.1 m (the paper's gates)
+  double alignment_window_s = 6.0;    ///< an alignment window: the last this many seconds of solutions (s)
+  double alignment_interval_s = 1.0;  ///< until aligned, try at most this often (s)
+  double realign_interval_s = 5.0;    ///< once aligned, refresh T_EO this often (s)
+  double max_window_sigma_m = 0.3;    ///< solutions with a larger 3-D position sigma do not join a window (m)
+  bool calibrate_lever_arm = true;    ///< estimate t_IA in the first alignment (pass 2)
+  Eigen::Vector3d lever_arm_prior_m = Eigen::Vector3d::Zero();  ///< t_IA prior (IMU frame, m)
+  bool coarse_alignment = true;            ///< beyond the paper: gravity-aligned yaw fit while no window qualifies
+  double coarse_window_s = 60.0;           ///< its window (s)
+  double coarse_min_spread_m = 5.0;        ///< RMS horizontal spread it needs (m)
+  double coarse_max_yaw_sigma_deg = 30.0;  ///< largest yaw uncertainty it accepts (deg)
+  Prediction prediction = Prediction::Vio;
+  bool vio_covariance = true;                ///< Eqs. 4-6; false: constant_increment_sigma_m per axis (ablation)
+  double constant_increment_sigma_m = 0.05;  ///< (m)
+  InnovationGate gate = InnovationGate::Both;
+  double gate_motion_factor = 5.0;       ///< paper: 5 x the VIO incremental motion
+  double min_gate_m = 0.5;               ///< the motion gate is at least this (standing still) (m)
+  double gate_sigmas = 4.0;              ///< chi-square gate: |v| <= this x sqrt(h P h^T + r)
+  double max_post_fit_normalised = 1.0;  ///< float validation: largest DD post-fit residual over the RTK engine's
+                                         ///< rejection threshold (1: the engine's own max_post_fit_sigmas)
+  double max_prior_chi2 = 16.27;         ///< float validation: chi-square(3) of the float against the prior (0.999)
+  bool false_fix_guard = true;           ///< beyond the paper: fixes must agree with the prior
+  double false_fix_chi2 = 16.27;         ///< chi-square(3) bound of the guard (0.999)
+  double max_fix_sigma_m = 0.1;          ///< a fix whose position sigma (largest axis) exceeds this is not taken:
+                                         ///< its DD geometry leaves the position undetermined (too few satellites)
+  Cn0ScreenOptions cn0;                  ///< beyond the paper: NLOS screening by C/N0 (cn0_screen.hpp)
+  int max_prior_rejections = 5;          ///< after this many consecutive epochs whose float failed only the prior
+                                         ///< check, the float is taken: GNSS re-anchors a drifted VIO prior
+  int gate_conflict_epochs = 5;          ///< after this many consecutive epochs in which the gates rejected more DD
+                                         ///< rows than the update used, the prior is widened by reanchor_sigma_m
+  double reanchor_sigma_m = 2.0;         ///< (m, per axis)
+
+  [[nodiscard]] std::string validate() const;
+};
+
+struct FusionEpoch {
+  core::Solution solution;  ///< Fixed, Float, VioFillIn, or (fallback) the RTK engine's
+  double hdop = 0.0;
+  bool aided = false;  ///< the VIO (or constant-velocity) prediction was used
+  std::string note;    ///< why the epoch is not fixed
+};
+
+struct AlignmentEvent {
+  core::GpsTime time;
+  std::string kind;  ///< "coarse", "initial" (two passes, calibration), "realign"
+  int points = 0;
+  double first_eigenvalue_ratio = 1.0;
+  double rmse_m = 0.0;
+  double rmse_without_calibration_m = 0.0;
+  double yaw_sigma_deg = 0.0;  ///< coarse
+};
+
+struct FusionStats {
+  int epochs = 0;
+  int aided = 0;
+  int fixed = 0;
+  int fill_in = 0;
+  int fallback = 0;  ///< epochs solved by the RTK engine's own motion model (not aligned, no VIO)
+  int no_vio = 0;    ///< epochs without a VIO pose
+  int float_rejected_no_phase = 0;
+  int float_rejected_post_fit = 0;
+  int float_rejected_prior = 0;
+  int guard_epochs = 0;             ///< epochs in which the false-fix guard rejected at least one candidate
+  int guard_candidates = 0;         ///< candidate fixes it rejected
+  int gated_rows = 0;               ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
+  int cn0_screened = 0;             ///< signals removed by the C/N0 screen
+  int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its undetermined position
+  int ar_pruned_epochs = 0;         ///< fixes obtained after pruning satellites by their ILS residual
+  int reanchored = 0;               ///< floats taken after max_prior_rejections (the prior had drifted)
+  int widened = 0;                  ///< priors widened after gate_conflict_epochs
+  int alignment_tries = 0;
+  int alignment_rejected_fer = 0;
+  int alignment_rejected_rmse = 0;
+  std::vector<AlignmentEvent> alignments;      ///< accepted ones
+  std::optional<AlignmentResult> calibration;  ///< the first (two-pass) alignment
+  double alignment_cpu_s = 0.0;
+  std::vector<std::string> notes;  ///< VIO segments, alignment losses
+};
+
+class FusionEngine {
+ public:
+  FusionEngine(FusionOptions options, const rtk::RtkOptions& rtk_options, const gnss::EphemerisStore& ephemerides,
+               const Eigen::Vector3d& p_E_base_m, VioTrack track);
+
+  /// One rover epoch with the base epoch to use (nullptr if none). Error when no solution at all exists (no VIO
+  /// prediction and no single-point solution).
+  Result<FusionEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base);
+
+  [[nodiscard]] const FusionStats& stats() const { return stats_; }
+  /// Human-readable summary: alignments, calibration and lever-arm observability, validation and guard counts.
+  [[nodiscard]] std::vector<std::string> report() const;
+
+ private:
+  struct Alignment {
+    core::Pose T_EO;
+    int segment = 0;
+    double yaw_sigma_rad = 0.0;  // coarse
+    bool fine = false;
+    core::GpsTime time;
+  };
+  struct WindowPoint {
+    core::GpsTime time;
+    core::Pose T_OI;
+    Eigen::Vector3d p_E_m;
+    core::SolutionStatus status = core::SolutionStatus::None;
+    double sigma_m = 0.0;
+    int segment = 0;
+    bool aided = false;
+  };
+  struct Prior {
+    Eigen::Vector3d p_E_m;
+    Eigen::Matrix3d P_E_m2;
+  };
+
+  std::optional<rtk::RtkAiding> make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
+  void update_alignment(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
+  [[nodiscard]] std::vector<AlignmentPoint> window(const core::GpsTime& t, double span_s, int segment,
+                                                   bool fixed_only) const;
+  [[nodiscard]] std::string validate_float(const rtk::RtkEpoch& epoch) const;
+
+  FusionOptions options_;
+  rtk::RtkOptions rtk_options_;
+  const gnss::EphemerisStore& ephemerides_;
+  Cn0Screen cn0_screen_;
+  rtk::RtkEngine engine_;
+  VioTrack track_;
+  std::optional<Alignment> alignment_;
+  Eigen::Vector3d t_IA_m_;
+  bool calibrated_ = false;
+  std::vector<WindowPoint> history_;  // recent solutions with their VIO poses (pruned to the longest window)
+  std::optional<core::GpsTime> last_alignment_try_;
+  std::optional<core::GpsTime> last_coarse_try_;
+  std::optional<Prior> prior_;  // of the epoch being processed
+  int guard_rejections_epoch_ = 0;
+  int undetermined_fixes_epoch_ = 0;
+  int prior_rejections_ = 0;  // consecutive
+  int gate_conflicts_ = 0;    // consecutive
+  bool widen_next_prior_ = false;
+  std::vector<core::Solution> last_solutions_;  // the last two outputs (constant-velocity prediction)
+  std::optional<int> last_segment_;
+  FusionStats stats_;
+};
+
+}  // namespace canyon::fusion

@@ -1,0 +1,106 @@
+#pragma once
+// The VIO trajectory on GPST: poses T_OI with their covariances, split into segments, interpolated on SE(3) at
+// GNSS epochs with the joint covariance of two interpolated poses.
+//
+// Segments. A new segment starts at a pose that is more than max_gap_s after the previous one (a gap), whose
+// implied speed or rotation rate from the previous one exceeds max_speed_mps or max_rotation_rate_dps (a jump: the
+// VIO reset or relocalised its odometry frame), or whose position covariance collapsed (trace below
+// reset_covariance_ratio times the previous one's: the VIO restarted its covariance with its frame). T_EO belongs to
+// one segment; the fusion re-aligns in a new one.
+//
+// Interpolation at time t between samples k and k+1 of one segment, a = (t - t_k) / (t_k+1 - t_k):
+//   T(t) = T_k Exp(a Log(T_k^-1 T_k+1)),   xi(t) = J_T_Tk xi_k + J_T_Tk+1 xi_k+1   (core::se3_interpolate).
+// At most extrapolation_s beyond the first or last sample of a segment, with a outside [0, 1].
+//
+// Joint covariance of two interpolated poses (from samples i, i+1 and j, j+1, i <= j): the covariances of the
+// samples involved, Sigma_kk = P_k, Sigma_k,k+1 = C_k+1 (the file's cov(xi_k, xi_k+1); zero when absent), and for
+// samples further apart the first-order propagation of an earlier pose's error through the relative motions in
+// between (the Markov completion of the consecutive-pose covariances, exact for VIO whose drift is a random walk
+// on the increments, as canyon's simulator and filter-based VIO):
+//   Sigma_k,l = Sigma_k,l-1 A_l^T,  A_l = Ad(D_l^-1),  D_l = T_l-1^-1 T_l   (l > k + 1).
+// Then cov([xi(t_a); xi(t_b)]) = J Sigma J^T with J the interpolation Jacobians (12 x 6 |samples|).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "canyon/core/result.hpp"
+#include "canyon/core/se3.hpp"
+#include "canyon/core/time.hpp"
+#include "canyon/fusion/time_bridge.hpp"
+#include "canyon/io/vio_file.hpp"
+
+namespace canyon::fusion {
+
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+
+struct VioTrackOptions {
+  double max_gap_s = 0.5;                ///< consecutive poses further apart in time: a gap (new segment) (s)
+  double max_speed_mps = 30.0;           ///< a larger implied speed between consecutive poses: a reset (m/s)
+  double max_rotation_rate_dps = 720.0;  ///< a larger implied rotation rate: a reset (deg/s)
+  double reset_covariance_ratio = 0.01;  ///< position covariance trace falling below this ratio: a reset
+  double extrapolation_s = 0.05;         ///< largest extrapolation beyond a segment's first or last pose (s)
+  bool use_cross_covariance = true;      ///< false: consecutive-pose cross-covariances taken as zero
+
+  [[nodiscard]] std::string validate() const;
+};
+
+struct VioTrackSample {
+  double t_s = 0.0;  ///< GPST seconds after the track's reference time
+  core::Pose T_OI;
+  core::Matrix6d P = core::Matrix6d::Zero();
+  core::Matrix6d C_previous = core::Matrix6d::Zero();  ///< cov(xi of the previous sample, xi of this one)
+  int segment = 0;
+  int line = 0;  ///< in the VIO file
+};
+
+/// A pose interpolated at one time: T = T_k Exp(a Log(T_k^-1 T_k+1)) with the Jacobians on both samples.
+struct VioPoseAt {
+  double t_s = 0.0;
+  int lower = 0;  ///< index of sample k (k + 1 is the upper one)
+  double a = 0.0;
+  int segment = 0;
+  core::Pose T_OI;
+  core::Matrix6d J_lower = core::Matrix6d::Identity();
+  core::Matrix6d J_upper = core::Matrix6d::Zero();
+};
+
+class VioTrack {
+ public:
+  /// Maps the file's device times to GPST, keeps the poses, splits segments. `notes` receive one line per gap or
+  /// reset. Error if no pose is left.
+  static Result<VioTrack> build(const io::VioFile& file, const TimeBridge& bridge, const VioTrackOptions& options,
+                                std::vector<std::string>& notes);
+  /// From samples directly (tests); times relative to `reference`.
+  static VioTrack from_samples(std::vector<VioTrackSample> samples, core::GpsTime reference,
+                               const VioTrackOptions& options = {});
+
+  /// The pose at GPST t, nullopt outside every segment (beyond extrapolation_s) or in a gap.
+  [[nodiscard]] std::optional<VioPoseAt> pose_at(const core::GpsTime& t) const;
+  /// Joint covariance of [xi(a); xi(b)] (12 x 12); a and b must be of one segment.
+  [[nodiscard]] Matrix12d joint_covariance(const VioPoseAt& a, const VioPoseAt& b) const;
+  /// Covariance of xi(a) alone.
+  [[nodiscard]] core::Matrix6d covariance(const VioPoseAt& a) const;
+
+  [[nodiscard]] const std::vector<VioTrackSample>& samples() const { return samples_; }
+  [[nodiscard]] core::GpsTime reference() const { return reference_; }
+  [[nodiscard]] core::GpsTime first_time() const { return reference_ + samples_.front().t_s; }
+  [[nodiscard]] core::GpsTime last_time() const { return reference_ + samples_.back().t_s; }
+  [[nodiscard]] int segments() const { return samples_.empty() ? 0 : samples_.back().segment + 1; }
+
+ private:
+  VioTrack(std::vector<VioTrackSample> samples, core::GpsTime reference, VioTrackOptions options)
+      : samples_(std::move(samples)), reference_(reference), options_(options) {}
+  /// cov(xi_k, xi_l) for samples k <= l of one segment.
+  [[nodiscard]] core::Matrix6d sample_covariance(int k, int l) const;
+
+  std::vector<VioTrackSample> samples_;
+  core::GpsTime reference_;
+  VioTrackOptions options_;
+};
+
+/// Splits samples into segments (gaps, jumps, covariance resets), appending a note for each break.
+void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
+                     const core::GpsTime& reference, std::vector<std::string>* notes);
+
+}  // namespace canyon::fusion

@@ -1,0 +1,421 @@
+// The paper's Algorithm 1 on canyon's RTK engine (see fusion_engine.hpp).
+
+#include "canyon/fusion/fusion_engine.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/core/geodesy.hpp"
+#include "canyon/fusion/vio_prediction.hpp"
+
+namespace canyon::fusion {
+namespace {
+
+std::string when(const core::GpsTime& t) {
+  const core::GpsTime n = t.normalized();
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "GPST %d %.1f", n.week, n.tow_s);
+  return buffer;
+}
+
+std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a, b, c, d);
+  return buffer;
+}
+
+/// d^T S^-1 d, or infinity if S is not positive definite.
+double chi2(const Eigen::Vector3d& d, const Eigen::Matrix3d& S) {
+  const Eigen::LLT<Eigen::Matrix3d> llt(0.5 * (S + S.transpose()));
+  if (llt.info() != Eigen::Success) return std::numeric_limits<double>::infinity();
+  return d.dot(llt.solve(d));
+}
+
+double sigma_3d(const Eigen::Matrix3d& P) {
+  return std::sqrt(std::max(P.trace(), 0.0));
+}
+
+}  // namespace
+
+const char* prediction_name(Prediction p) {
+  return p == Prediction::Vio ? "vio" : "constant_velocity";
+}
+
+const char* innovation_gate_name(InnovationGate g) {
+  switch (g) {
+    case InnovationGate::Off: return "off";
+    case InnovationGate::Paper: return "paper";
+    case InnovationGate::ChiSquare: return "chi_square";
+    case InnovationGate::Both: return "both";
+  }
+  return "?";
+}
+
+std::string FusionOptions::validate() const {
+  if (const std::string e = time_sync.validate(); !e.empty()) return "time_sync: " + e;
+  if (const std::string e = vio.validate(); !e.empty()) return "vio: " + e;
+  if (const std::string e = alignment.validate(); !e.empty()) return "alignment: " + e;
+  if (std::string e = cn0.validate(); !e.empty()) return e;
+  if (!(alignment_window_s > 0.0)) return "alignment_window_s must be > 0";
+  if (!(alignment_interval_s >= 0.0) || !(realign_interval_s >= 0.0)) {
+    return "alignment_interval_s and realign_interval_s must be >= 0";
+  }
+  if (!(max_window_sigma_m > 0.0)) return "max_window_sigma_m must be > 0";
+  if (!lever_arm_prior_m.allFinite() || lever_arm_prior_m.norm() > 10.0) {
+    return "lever_arm_prior_m must be finite and shorter than 10 m";
+  }
+  if (!(coarse_window_s > 0.0) || !(coarse_min_spread_m > 0.0) || !(coarse_max_yaw_sigma_deg > 0.0)) {
+    return "coarse_window_s, coarse_min_spread_m and coarse_max_yaw_sigma_deg must be > 0";
+  }
+  if (!(constant_increment_sigma_m > 0.0)) return "constant_increment_sigma_m must be > 0";
+  if (!(gate_motion_factor > 0.0) || !(min_gate_m > 0.0) || !(gate_sigmas > 0.0)) {
+    return "gate_motion_factor, min_gate_m and gate_sigmas must be > 0";
+  }
+  if (max_prior_rejections < 0 || gate_conflict_epochs < 1 || !(reanchor_sigma_m > 0.0)) {
+    return "max_prior_rejections must be >= 0, gate_conflict_epochs >= 1 and reanchor_sigma_m > 0";
+  }
+  if (!(max_fix_sigma_m > 0.0)) return "max_fix_sigma_m must be > 0";
+  if (!(max_post_fit_normalised > 0.0) || !(max_prior_chi2 > 0.0) || !(false_fix_chi2 > 0.0)) {
+    return "max_post_fit_normalised, max_prior_chi2 and false_fix_chi2 must be > 0";
+  }
+  return {};
+}
+
+FusionEngine::FusionEngine(FusionOptions options, const rtk::RtkOptions& rtk_options,
+                           const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m, VioTrack track)
+    : options_(std::move(options)),
+      rtk_options_(rtk_options),
+      ephemerides_(ephemerides),
+      cn0_screen_(options_.cn0),
+      engine_(rtk_options, ephemerides, p_E_base_m),
+      track_(std::move(track)),
+      t_IA_m_(options_.lever_arm_prior_m) {}
+
+std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose) {
+  prior_.reset();
+  if (!engine_.has_position() || !engine_.state_time()) return std::nullopt;
+  const core::GpsTime t_state = *engine_.state_time();
+  rtk::RtkAiding aiding;
+  const Eigen::Vector3d p_state = engine_.position_E_m();
+  if (options_.prediction == Prediction::Vio) {
+    if (!alignment_ || !pose) return std::nullopt;
+    const auto before = track_.pose_at(t_state);
+    if (!before || before->segment != pose->segment || pose->segment != alignment_->segment) return std::nullopt;
+    const Eigen::Vector3d up_E =
+        core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_state)).row(2).transpose();  // local vertical
+    const VioIncrement inc = vio_increment(before->T_OI, pose->T_OI, track_.joint_covariance(*before, *pose), t_IA_m_,
+                                           alignment_->T_EO.rotation(), alignment_->yaw_sigma_rad, up_E);
+    aiding.delta_p_E_m = inc.dp_E_m;
+    if (options_.vio_covariance) {
+      aiding.Q_E_m2 = inc.cov_E_m2;
+    } else {
+      aiding.Q_E_m2 =
+          Eigen::Matrix3d::Identity() * options_.constant_increment_sigma_m * options_.constant_increment_sigma_m;
+    }
+  } else {
+    // Constant velocity from the last two solutions.
+    if (last_solutions_.size() < 2) return std::nullopt;
+    const core::Solution& a = last_solutions_[0];
+    const core::Solution& b = last_solutions_[1];
+    const double dt_k = b.time - a.time;
+    const double dt = t - t_state;
+    if (!(dt_k > 0.0) || dt_k > 5.0 || dt < 0.0) return std::nullopt;
+    const Eigen::Vector3d v = (b.p_E_m - a.p_E_m) / dt_k;
+    if (!(v.norm() <= options_.vio.max_speed_mps)) return std::nullopt;  // a jump between solutions, not a motion
+    aiding.delta_p_E_m = v * dt;
+    const double sa = rtk_options_.accel_sigma_h_mps2;
+    aiding.Q_E_m2 =
+        Eigen::Matrix3d::Identity() * sa * sa * dt * dt * dt / 3.0 + (a.P_E_m2 + b.P_E_m2) * (dt / dt_k) * (dt / dt_k);
+  }
+  if (widen_next_prior_) {
+    aiding.Q_E_m2 += Eigen::Matrix3d::Identity() * options_.reanchor_sigma_m * options_.reanchor_sigma_m;
+    widen_next_prior_ = false;
+    ++stats_.widened;
+  }
+  Prior prior{p_state + aiding.delta_p_E_m, engine_.position_covariance_E_m2() + aiding.Q_E_m2};
+  prior_ = prior;
+  const double motion_m = aiding.delta_p_E_m.norm();
+  if (options_.gate == InnovationGate::Paper || options_.gate == InnovationGate::Both) {
+    aiding.max_phase_innovation_m = std::max(options_.gate_motion_factor * motion_m, options_.min_gate_m);
+  }
+  if (options_.gate == InnovationGate::ChiSquare || options_.gate == InnovationGate::Both) {
+    aiding.max_normalised_innovation = options_.gate_sigmas;
+  }
+  const double bound = options_.false_fix_guard ? options_.false_fix_chi2 : -1.0;
+  const double max_variance = options_.max_fix_sigma_m * options_.max_fix_sigma_m;
+  aiding.accept_fix = [this, prior, bound, max_variance](const Eigen::Vector3d& p_fix, const Eigen::Matrix3d& P_fix) {
+    if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_fix, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff() >
+        max_variance) {
+      ++undetermined_fixes_epoch_;
+      return false;
+    }
+    if (bound < 0.0 || chi2(p_fix - prior.p_E_m, prior.P_E_m2 + P_fix) <= bound) return true;
+    ++guard_rejections_epoch_;
+    return false;
+  };
+  return aiding;
+}
+
+std::string FusionEngine::validate_float(const rtk::RtkEpoch& epoch) const {
+  if (epoch.num_dd_measurements == 0) return "no double-differenced phase";
+  if (epoch.max_post_fit_normalised > options_.max_post_fit_normalised) {
+    return format("post-fit residual %.1f times the rejection threshold", epoch.max_post_fit_normalised);
+  }
+  const double c = chi2(epoch.float_p_E_m - epoch.prior_p_E_m, epoch.prior_P_E_m2);
+  if (c > options_.max_prior_chi2) {
+    return format("float %.2f m from the VIO prior (chi-square %.0f)", (epoch.float_p_E_m - epoch.prior_p_E_m).norm(),
+                  c);
+  }
+  return {};
+}
+
+Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+  ++stats_.epochs;
+  const std::optional<VioPoseAt> pose = track_.pose_at(rover.time);
+  if (!pose) ++stats_.no_vio;
+  if (pose && last_segment_ && *last_segment_ != pose->segment) {
+    stats_.notes.push_back(when(rover.time) + ": new VIO segment " + std::to_string(pose->segment) +
+                           " (gap or reset): RTK motion model until it aligns");
+  }
+  if (pose) last_segment_ = pose->segment;
+  if (alignment_ && pose && pose->segment != alignment_->segment) alignment_.reset();
+
+  guard_rejections_epoch_ = 0;
+  undetermined_fixes_epoch_ = 0;
+  std::optional<rtk::RtkAiding> aiding = make_aiding(rover.time, pose);
+  // The C/N0 screen learns from every epoch but screens only aided ones: before the VIO is aligned the RTK engine
+  // needs every signal it can get for the solutions the alignment starts from.
+  core::ObsEpoch screened;
+  const core::ObsEpoch* observed = &rover;
+  if (options_.cn0.enabled && engine_.has_position()) {
+    screened = rover;
+    const Eigen::Vector3d p_approx = prior_ ? prior_->p_E_m : engine_.position_E_m();
+    const int removed = cn0_screen_.apply(screened, ephemerides_, p_approx);
+    if (aiding) {
+      stats_.cn0_screened += removed;
+      observed = &screened;
+    }
+  }
+  auto result = engine_.process(*observed, base, aiding ? &*aiding : nullptr);
+  if (undetermined_fixes_epoch_ > 0) ++stats_.undetermined_fix_epochs;
+  if (guard_rejections_epoch_ > 0) {
+    ++stats_.guard_epochs;
+    stats_.guard_candidates += guard_rejections_epoch_;
+  }
+  FusionEpoch out;
+  if (!result) {
+    update_alignment(rover.time, pose);
+    return result.error();
+  }
+  stats_.gated_rows += static_cast<int>(result->rejected.size());
+  out.hdop = result->hdop;
+  out.note = result->note;
+  if (aiding && prior_) {
+    out.aided = true;
+    ++stats_.aided;
+    std::string invalid;
+    if (!result->aided) {
+      invalid = result->note.empty() ? "no update" : result->note;  // returned before its time update: state kept
+    } else {
+      invalid = validate_float(*result);
+      const bool only_prior = !invalid.empty() && result->num_dd_measurements > 0 &&
+                              result->max_post_fit_normalised <= options_.max_post_fit_normalised;
+      prior_rejections_ = only_prior ? prior_rejections_ + 1 : 0;
+      if (only_prior && prior_rejections_ > options_.max_prior_rejections) {
+        invalid.clear();  // the VIO prior drifted away from a consistent GNSS solution: GNSS re-anchors it
+        prior_rejections_ = 0;
+        ++stats_.reanchored;
+      }
+      if (!invalid.empty()) {
+        if (result->num_dd_measurements == 0) {
+          ++stats_.float_rejected_no_phase;
+        } else if (!only_prior) {
+          ++stats_.float_rejected_post_fit;
+        } else {
+          ++stats_.float_rejected_prior;
+        }
+        engine_.revert_to_prior();
+      }
+      const auto used = result->num_dd_measurements + result->num_dd_code_measurements;
+      gate_conflicts_ = static_cast<int>(result->rejected.size()) > used ? gate_conflicts_ + 1 : 0;
+      if (gate_conflicts_ >= options_.gate_conflict_epochs) {
+        widen_next_prior_ = true;
+        gate_conflicts_ = 0;
+      }
+    }
+    if (!invalid.empty()) {
+      // Algorithm 1, line 22: the prior, i.e. the aligned VIO fill-in.
+      core::Solution& s = out.solution;
+      s = result->solution;
+      if (s.status == core::SolutionStatus::None) s.time = rover.time;
+      s.status = core::SolutionStatus::VioFillIn;
+      s.p_E_m = result->aided ? result->prior_p_E_m : prior_->p_E_m;
+      s.P_E_m2 = result->aided ? result->prior_P_E_m2 : prior_->P_E_m2;
+      s.ratio = 0.0;
+      out.note = "VIO fill-in: " + invalid;
+      ++stats_.fill_in;
+    } else {
+      out.solution = result->solution;
+      if (!result->ar_pruned.empty() && out.solution.status == core::SolutionStatus::Fixed) ++stats_.ar_pruned_epochs;
+    }
+  } else {
+    out.solution = result->solution;
+    ++stats_.fallback;
+  }
+  if (out.solution.status == core::SolutionStatus::Fixed) ++stats_.fixed;
+
+  // Remember the solution with its VIO pose for the alignment windows, and for the constant-velocity prediction.
+  if (pose && out.solution.status != core::SolutionStatus::VioFillIn &&
+      out.solution.status != core::SolutionStatus::None) {
+    history_.push_back(WindowPoint{rover.time, pose->T_OI, out.solution.p_E_m, out.solution.status,
+                                   sigma_3d(out.solution.P_E_m2), pose->segment, out.aided});
+  }
+  const double keep_s = std::max({options_.alignment_window_s, options_.coarse_window_s}) + 1.0;
+  while (!history_.empty() && rover.time - history_.front().time > keep_s) history_.erase(history_.begin());
+  if (out.solution.status == core::SolutionStatus::Fixed || out.solution.status == core::SolutionStatus::Float) {
+    last_solutions_.push_back(out.solution);
+    if (last_solutions_.size() > 2) last_solutions_.erase(last_solutions_.begin());
+  }
+  update_alignment(rover.time, pose);
+  return out;
+}
+
+std::vector<AlignmentPoint> FusionEngine::window(const core::GpsTime& t, double span_s, int segment,
+                                                 bool fixed_only) const {
+  std::vector<AlignmentPoint> points;
+  for (const WindowPoint& w : history_) {
+    if (t - w.time > span_s || w.segment != segment) continue;
+    if (fixed_only ? w.status != core::SolutionStatus::Fixed
+                   : (w.status != core::SolutionStatus::Fixed && w.status != core::SolutionStatus::Float)) {
+      continue;
+    }
+    if (w.sigma_m > options_.max_window_sigma_m) continue;
+    points.push_back(AlignmentPoint{w.T_OI, w.p_E_m});
+  }
+  return points;
+}
+
+void FusionEngine::update_alignment(const core::GpsTime& t, const std::optional<VioPoseAt>& pose) {
+  if (!pose || options_.prediction != Prediction::Vio) return;
+  const int segment = pose->segment;
+  const bool fine = alignment_ && alignment_->fine;
+  const double interval = fine ? options_.realign_interval_s : options_.alignment_interval_s;
+  if (last_alignment_try_ && t - *last_alignment_try_ < interval) return;
+  last_alignment_try_ = t;
+  const auto start = std::chrono::steady_clock::now();
+  // Fine alignment (the paper's): before any alignment the RTK solutions, fixed or float; afterwards fixed ones.
+  const std::vector<AlignmentPoint> points = window(t, options_.alignment_window_s, segment, alignment_.has_value());
+  if (static_cast<int>(points.size()) >= options_.alignment.min_points) {
+    ++stats_.alignment_tries;
+    std::vector<Eigen::Vector3d> positions;
+    positions.reserve(points.size());
+    for (const AlignmentPoint& p : points) positions.push_back(p.p_E_m);
+    if (first_eigenvalue_ratio(positions) >= options_.alignment.max_first_eigenvalue_ratio) {
+      ++stats_.alignment_rejected_fer;
+    } else {
+      const bool first = !calibrated_ && options_.calibrate_lever_arm;
+      Result<AlignmentResult> fit =
+          first  ? align_and_calibrate(points, options_.lever_arm_prior_m, true, options_.alignment)
+          : fine ? realign(points, t_IA_m_, alignment_->T_EO, options_.alignment)
+                 : align_and_calibrate(points, t_IA_m_, false, options_.alignment);
+      if (fit && fit->qualifies(options_.alignment)) {
+        if (first) {
+          calibrated_ = true;
+          t_IA_m_ = fit->t_IA_m;
+          stats_.calibration = *fit;
+        }
+        alignment_ = Alignment{fit->T_EO, segment, 0.0, true, t};
+        stats_.alignments.push_back(AlignmentEvent{t, first ? "initial" : (fine ? "realign" : "align"), fit->points,
+                                                   fit->first_eigenvalue_ratio, fit->rmse_m,
+                                                   fit->rmse_without_calibration_m, 0.0});
+      } else if (fit) {
+        ++stats_.alignment_rejected_rmse;
+      }
+    }
+  }
+  // Coarse alignment while no fine one holds: all RTK solutions before any alignment, fixed ones afterwards.
+  if (options_.coarse_alignment && !(alignment_ && alignment_->fine)) {
+    std::vector<AlignmentPoint> coarse_points;
+    for (const WindowPoint& w : history_) {
+      if (t - w.time > options_.coarse_window_s || w.segment != segment) continue;
+      if (alignment_ && w.status != core::SolutionStatus::Fixed) continue;
+      if (!alignment_ && w.aided) continue;
+      coarse_points.push_back(AlignmentPoint{w.T_OI, w.p_E_m});
+    }
+    auto coarse = coarse_align(coarse_points, t_IA_m_, options_.alignment);
+    const double max_sigma_rad = options_.coarse_max_yaw_sigma_deg * core::kDegToRad;
+    if (coarse && coarse->spread_m >= options_.coarse_min_spread_m && coarse->yaw_sigma_rad <= max_sigma_rad &&
+        (!alignment_ || coarse->yaw_sigma_rad < alignment_->yaw_sigma_rad)) {
+      alignment_ = Alignment{coarse->T_EO, segment, coarse->yaw_sigma_rad, false, t};
+      stats_.alignments.push_back(AlignmentEvent{t, "coarse", static_cast<int>(coarse_points.size()), 0.0,
+                                                 coarse->rmse_m, coarse->rmse_m,
+                                                 coarse->yaw_sigma_rad * core::kRadToDeg});
+    }
+  }
+  stats_.alignment_cpu_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<std::string> FusionEngine::report() const {
+  std::vector<std::string> lines;
+  const FusionStats& s = stats_;
+  lines.push_back(
+      format("fusion: %.0f epochs: %.0f VIO-aided, %.0f VIO fill-in (Q 7), %.0f RTK motion model "
+             "(not aligned or no VIO)",
+             s.epochs, s.aided, s.fill_in, s.fallback));
+  lines.push_back(
+      format("fusion: float validation failed: %.0f no DD phase, %.0f post-fit residuals, %.0f "
+             "inconsistent with the VIO prior",
+             s.float_rejected_no_phase, s.float_rejected_post_fit, s.float_rejected_prior));
+  lines.push_back(format("fusion: false-fix guard fired in %.0f epochs (%.0f candidate fixes); %.0f fixes after ILS "
+                         "pruning; %.0f DD rows gated",
+                         s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
+                  format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of an undetermined position",
+                         s.cn0_screened, s.undetermined_fix_epochs));
+  int coarse = 0, fine = 0;
+  for (const AlignmentEvent& a : s.alignments) (a.kind == "coarse" ? coarse : fine) += 1;
+  lines.push_back(format("fusion: alignments: %.0f fine of %.0f windows tried (%.0f with FER >= the limit, ", fine,
+                         s.alignment_tries, s.alignment_rejected_fer) +
+                  format("%.0f with RMSE >= the limit), %.0f coarse; %.3f s CPU", s.alignment_rejected_rmse, coarse,
+                         s.alignment_cpu_s));
+  // The first coarse alignment of each run of them, the last one, and every fine alignment but the re-alignments.
+  const AlignmentEvent* last_coarse = nullptr;
+  int coarse_run = 0;
+  const auto coarse_line = [&lines](const AlignmentEvent& a, const char* what) {
+    lines.push_back("fusion: " + when(a.time) + ": " + what + ", " + std::to_string(a.points) +
+                    format(" solutions, yaw sigma %.2f deg, horizontal RMSE %.2f m", a.yaw_sigma_deg, a.rmse_m));
+  };
+  const auto flush_coarse = [&]() {
+    if (last_coarse != nullptr && coarse_run > 1) coarse_line(*last_coarse, "last coarse alignment of this run");
+    last_coarse = nullptr;
+    coarse_run = 0;
+  };
+  for (const AlignmentEvent& a : s.alignments) {
+    if (a.kind == "coarse") {
+      if (coarse_run++ == 0) coarse_line(a, "coarse alignment");
+      last_coarse = &a;
+      continue;
+    }
+    flush_coarse();
+    if (a.kind == "realign") continue;
+    lines.push_back("fusion: " + when(a.time) + ": " + a.kind + " alignment, " + std::to_string(a.points) +
+                    format(" solutions, FER %.3f, RMSE %.3f m (without calibration %.3f m)", a.first_eigenvalue_ratio,
+                           a.rmse_m, a.rmse_without_calibration_m));
+  }
+  flush_coarse();
+  if (s.calibration) {
+    const Eigen::Vector3d& t = s.calibration->t_IA_m;
+    lines.push_back(format("fusion: lever arm t_IA = [%.3f, %.3f, %.3f] m; ", t.x(), t.y(), t.z()) +
+                    s.calibration->lever_arm.describe());
+  }
+  for (const std::string& note : s.notes) lines.push_back("fusion: " + note);
+  return lines;
+}
+
+}  // namespace canyon::fusion

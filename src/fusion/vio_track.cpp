@@ -1,0 +1,179 @@
+// VIO trajectory on GPST: segments, SE(3) interpolation, joint covariances (see vio_track.hpp).
+
+#include "canyon/fusion/vio_track.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "canyon/core/constants.hpp"
+
+namespace canyon::fusion {
+namespace {
+
+constexpr double kMinResetTraceM2 = 1e-4;  // covariance collapses are only resets from above this trace (m^2)
+
+std::string when(const core::GpsTime& t) {
+  const core::GpsTime n = t.normalized();
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "GPST %d %.3f", n.week, n.tow_s);
+  return buffer;
+}
+
+}  // namespace
+
+std::string VioTrackOptions::validate() const {
+  if (!(max_gap_s > 0.0)) return "max_gap_s must be > 0";
+  if (!(max_speed_mps > 0.0)) return "max_speed_mps must be > 0";
+  if (!(max_rotation_rate_dps > 0.0)) return "max_rotation_rate_dps must be > 0";
+  if (!(reset_covariance_ratio >= 0.0 && reset_covariance_ratio < 1.0)) {
+    return "reset_covariance_ratio must be in [0, 1)";
+  }
+  if (!(extrapolation_s >= 0.0)) return "extrapolation_s must be >= 0";
+  return {};
+}
+
+void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
+                     const core::GpsTime& reference, std::vector<std::string>* notes) {
+  int segment = 0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    VioTrackSample& s = samples[k];
+    bool new_segment = k == 0;
+    if (k > 0) {
+      const VioTrackSample& prev = samples[k - 1];
+      const double dt_s = s.t_s - prev.t_s;
+      const double jump_m = (s.T_OI.p - prev.T_OI.p).norm();
+      const double turn_deg = core::so3_log(prev.T_OI.q.conjugate() * s.T_OI.q).norm() * core::kRadToDeg;
+      const double trace = s.P.topLeftCorner<3, 3>().trace();
+      const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
+      std::string why;
+      char buffer[160];
+      if (dt_s > options.max_gap_s) {
+        std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s", dt_s);
+        why = buffer;
+      } else if (jump_m > options.max_speed_mps * dt_s || turn_deg > options.max_rotation_rate_dps * dt_s) {
+        std::snprintf(buffer, sizeof buffer, "VIO jump of %.2f m and %.1f deg in %.3f s (odometry frame reset)", jump_m,
+                      turn_deg, dt_s);
+        why = buffer;
+      } else if (prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace) {
+        std::snprintf(buffer, sizeof buffer, "VIO covariance reset (position trace %.3g -> %.3g m^2)", prev_trace,
+                      trace);
+        why = buffer;
+      }
+      if (!why.empty()) {
+        ++segment;
+        new_segment = true;
+        if (notes != nullptr) {
+          notes->push_back(why + " at " + when(reference + s.t_s) + " (line " + std::to_string(s.line) +
+                           "): new VIO segment " + std::to_string(segment) + ", fusion re-aligns");
+        }
+      }
+    }
+    s.segment = segment;
+    if (new_segment) s.C_previous.setZero();  // no predecessor in its segment
+  }
+}
+
+Result<VioTrack> VioTrack::build(const io::VioFile& file, const TimeBridge& bridge, const VioTrackOptions& options,
+                                 std::vector<std::string>& notes) {
+  if (const std::string e = options.validate(); !e.empty()) return Error{"vio track: " + e};
+  if (file.records.empty()) return Error{"no VIO pose"};
+  const core::GpsTime reference = bridge.to_gps(file.records.front().t_ns);
+  std::vector<VioTrackSample> samples;
+  samples.reserve(file.records.size());
+  for (const io::VioRecord& r : file.records) {
+    VioTrackSample s;
+    s.t_s = bridge.to_gps(r.t_ns) - reference;
+    if (!samples.empty() && !(s.t_s > samples.back().t_s)) continue;  // a clock fit cannot reorder, but be safe
+    s.T_OI = r.T_OI;
+    s.P = r.covariance;
+    if (options.use_cross_covariance && r.cross_previous) s.C_previous = *r.cross_previous;
+    s.line = r.line;
+    samples.push_back(s);
+  }
+  assign_segments(samples, options, reference, &notes);
+  return VioTrack(std::move(samples), reference, options);
+}
+
+VioTrack VioTrack::from_samples(std::vector<VioTrackSample> samples, core::GpsTime reference,
+                                const VioTrackOptions& options) {
+  assign_segments(samples, options, reference, nullptr);
+  return VioTrack(std::move(samples), reference, options);
+}
+
+std::optional<VioPoseAt> VioTrack::pose_at(const core::GpsTime& t) const {
+  if (samples_.empty()) return std::nullopt;
+  const double t_s = t - reference_;
+  // First sample after t.
+  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
+                                   [](double value, const VioTrackSample& s) { return value < s.t_s; });
+  auto upper = static_cast<int>(it - samples_.begin());
+  int lower = upper - 1;
+  const auto n = static_cast<int>(samples_.size());
+  const auto same_segment = [&](int i, int j) {
+    return i >= 0 && j < n &&
+           samples_[static_cast<std::size_t>(i)].segment == samples_[static_cast<std::size_t>(j)].segment;
+  };
+  if (!same_segment(lower, upper)) {
+    // Before the first sample of a segment or after its last: extrapolate a little from its first or last interval.
+    if (upper < n && upper + 1 < n && same_segment(upper, upper + 1) &&
+        samples_[static_cast<std::size_t>(upper)].t_s - t_s <= options_.extrapolation_s) {
+      lower = upper;
+      upper = upper + 1;
+    } else if (lower >= 1 && same_segment(lower - 1, lower) &&
+               t_s - samples_[static_cast<std::size_t>(lower)].t_s <= options_.extrapolation_s) {
+      upper = lower;
+      lower = lower - 1;
+    } else {
+      return std::nullopt;
+    }
+  }
+  const VioTrackSample& s0 = samples_[static_cast<std::size_t>(lower)];
+  const VioTrackSample& s1 = samples_[static_cast<std::size_t>(upper)];
+  VioPoseAt p;
+  p.t_s = t_s;
+  p.lower = lower;
+  p.segment = s0.segment;
+  p.a = (t_s - s0.t_s) / (s1.t_s - s0.t_s);
+  p.T_OI = core::se3_interpolate(s0.T_OI, s1.T_OI, p.a, &p.J_lower, &p.J_upper);
+  return p;
+}
+
+core::Matrix6d VioTrack::sample_covariance(int k, int l) const {
+  if (k == l) return samples_[static_cast<std::size_t>(k)].P;
+  if (k > l) return sample_covariance(l, k).transpose();
+  if (l == k + 1) return samples_[static_cast<std::size_t>(l)].C_previous;
+  // Propagate the earlier error through the relative motion D_l = T_l-1^-1 T_l: Sigma_kl = Sigma_k,l-1 Ad(D_l^-1)^T.
+  core::Matrix6d sigma = samples_[static_cast<std::size_t>(k) + 1].C_previous;
+  for (int m = k + 2; m <= l; ++m) {
+    const core::Pose D =
+        samples_[static_cast<std::size_t>(m - 1)].T_OI.inverse() * samples_[static_cast<std::size_t>(m)].T_OI;
+    sigma = sigma * core::se3_adjoint(D.inverse()).transpose();
+  }
+  return sigma;
+}
+
+Matrix12d VioTrack::joint_covariance(const VioPoseAt& a, const VioPoseAt& b) const {
+  // xi(a) = J_a0 xi_i + J_a1 xi_i+1, xi(b) = J_b0 xi_j + J_b1 xi_j+1.
+  const std::array<int, 4> index = {a.lower, a.lower + 1, b.lower, b.lower + 1};
+  const std::array<const core::Matrix6d*, 4> J = {&a.J_lower, &a.J_upper, &b.J_lower, &b.J_upper};
+  Matrix12d out = Matrix12d::Zero();
+  for (int u = 0; u < 4; ++u) {
+    for (int v = 0; v < 4; ++v) {
+      const int row = u < 2 ? 0 : 6;
+      const int col = v < 2 ? 0 : 6;
+      out.block<6, 6>(row, col) +=
+          *J[static_cast<std::size_t>(u)] *
+          sample_covariance(index[static_cast<std::size_t>(u)], index[static_cast<std::size_t>(v)]) *
+          J[static_cast<std::size_t>(v)]->transpose();
+    }
+  }
+  return 0.5 * (out + out.transpose());
+}
+
+core::Matrix6d VioTrack::covariance(const VioPoseAt& a) const {
+  return joint_covariance(a, a).topLeftCorner<6, 6>();
+}
+
+}  // namespace canyon::fusion
