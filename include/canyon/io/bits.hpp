@@ -1,0 +1,132 @@
+#pragma once
+// Bit fields of binary GNSS messages (RTCM 3, navigation words): most significant bit first, as both RTCM 10403.3
+// and the satellite ICDs number them, and the CRC-24Q of RTCM 3 and Galileo I/NAV.
+//
+// BitReader does not check bounds per field: a decoder checks once that the message holds every bit it will read
+// (bits_left()), then reads without branches. Reading past the end is a programmer error (assertion).
+
+#include <cassert>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace canyon::io {
+
+/// CRC-24Q (polynomial 0x1864CFB, initial value 0, no reflection) of `data`: the RTCM 3 frame check.
+[[nodiscard]] std::uint32_t crc24q(std::span<const std::uint8_t> data);
+
+/// Unsigned field of `n` bits (n <= 64) at bit `pos` of `data`; the caller guarantees pos + n <= 8 * size.
+[[nodiscard]] inline std::uint64_t get_bits(const std::uint8_t* data, std::size_t size, std::size_t pos, unsigned n) {
+  assert(n <= 64 && pos + n <= 8 * size);
+  if (n == 0) return 0;
+  if (n > 56) {
+    const std::uint64_t high = get_bits(data, size, pos, n - 32);
+    return (high << 32) | get_bits(data, size, pos + n - 32, 32);
+  }
+  const std::size_t first = pos >> 3;
+  const unsigned skip = static_cast<unsigned>(pos & 7);
+  const std::size_t last = (pos + n - 1) >> 3;  // inclusive
+  std::uint64_t word = 0;
+  if (first + 8 <= size) {
+    // Eight bytes, big-endian, whatever n is: one load (the compiler merges the shifts) and two shifts.
+    for (std::size_t i = 0; i < 8; ++i) word = (word << 8) | data[first + i];
+  } else {
+    for (std::size_t i = first; i <= last; ++i) word = (word << 8) | data[i];
+    word <<= 8 * (8 - (last - first + 1));
+  }
+  return (word << skip) >> (64 - n);
+}
+
+/// Two's complement field of `n` bits (2 <= n <= 64).
+[[nodiscard]] inline std::int64_t get_bits_signed(const std::uint8_t* data, std::size_t size, std::size_t pos,
+                                                  unsigned n) {
+  const std::uint64_t u = get_bits(data, size, pos, n);
+  if (n == 64) return static_cast<std::int64_t>(u);
+  const std::uint64_t sign = std::uint64_t{1} << (n - 1);
+  return static_cast<std::int64_t>(u ^ sign) - static_cast<std::int64_t>(sign);
+}
+
+/// Sign-magnitude field of `n` bits (GLONASS): the first bit is the sign.
+[[nodiscard]] inline std::int64_t get_bits_sign_magnitude(const std::uint8_t* data, std::size_t size, std::size_t pos,
+                                                          unsigned n) {
+  const std::uint64_t u = get_bits(data, size, pos, n);
+  const std::uint64_t magnitude = u & ((std::uint64_t{1} << (n - 1)) - 1);
+  return (u >> (n - 1)) != 0 ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
+}
+
+/// Sequential reader over a message.
+class BitReader {
+ public:
+  explicit BitReader(std::span<const std::uint8_t> data, std::size_t pos = 0) : data_(data), pos_(pos) {}
+
+  [[nodiscard]] std::size_t position() const { return pos_; }
+  [[nodiscard]] std::size_t bits_left() const { return 8 * data_.size() - pos_; }
+  void skip(std::size_t n) {
+    assert(n <= bits_left());
+    pos_ += n;
+  }
+
+  std::uint64_t u(unsigned n) {
+    const std::uint64_t v = get_bits(data_.data(), data_.size(), pos_, n);
+    pos_ += n;
+    return v;
+  }
+  std::uint32_t u32(unsigned n) {
+    assert(n <= 32);
+    return static_cast<std::uint32_t>(u(n));
+  }
+  std::int64_t s(unsigned n) {
+    const std::int64_t v = get_bits_signed(data_.data(), data_.size(), pos_, n);
+    pos_ += n;
+    return v;
+  }
+  std::int64_t sm(unsigned n) {
+    const std::int64_t v = get_bits_sign_magnitude(data_.data(), data_.size(), pos_, n);
+    pos_ += n;
+    return v;
+  }
+
+ private:
+  std::span<const std::uint8_t> data_;
+  std::size_t pos_;
+};
+
+/// Sequential writer: appends fields to a byte vector (the last byte is zero-padded).
+class BitWriter {
+ public:
+  explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out), start_bits_(8 * out.size()) {}
+
+  /// Appends the low `n` bits of `value` (n <= 64).
+  void u(std::uint64_t value, unsigned n) {
+    assert(n <= 64);
+    while (n > 0) {
+      const unsigned used = static_cast<unsigned>(bits_ & 7);
+      if (used == 0) out_.push_back(0);
+      const unsigned room = 8 - used;
+      const unsigned take = n < room ? n : room;
+      const auto chunk = static_cast<std::uint8_t>((value >> (n - take)) & ((1U << take) - 1));
+      out_.back() = static_cast<std::uint8_t>(out_.back() | (chunk << (room - take)));
+      n -= take;
+      bits_ += take;
+    }
+  }
+  /// Two's complement; the caller checks the range.
+  void s(std::int64_t value, unsigned n) { u(static_cast<std::uint64_t>(value), n); }
+  /// Sign-magnitude (GLONASS): sign bit, then |value| in n - 1 bits.
+  void sm(std::int64_t value, unsigned n) {
+    const std::uint64_t magnitude = static_cast<std::uint64_t>(value < 0 ? -value : value);
+    u(((value < 0 ? std::uint64_t{1} : 0) << (n - 1)) | magnitude, n);
+  }
+  /// Bits written by this writer.
+  [[nodiscard]] std::size_t bits() const { return bits_; }
+  /// Absolute bit position in the vector.
+  [[nodiscard]] std::size_t position() const { return start_bits_ + bits_; }
+
+ private:
+  std::vector<std::uint8_t>& out_;
+  std::size_t start_bits_;
+  std::size_t bits_ = 0;
+};
+
+}  // namespace canyon::io
