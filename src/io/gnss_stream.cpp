@@ -85,12 +85,14 @@ void GnssStreamDecoder::drain() {
 void GnssStreamDecoder::collect_navigation() {
   const core::NavigationData& r = rtcm3_.navigation();
   const core::NavigationData& u = ubx_.navigation();
-  for (; rtcm3_kepler_seen_ < r.kepler.size(); ++rtcm3_kepler_seen_) nav_.kepler.push_back(r.kepler[rtcm3_kepler_seen_]);
+  for (; rtcm3_kepler_seen_ < r.kepler.size(); ++rtcm3_kepler_seen_)
+    nav_.kepler.push_back(r.kepler[rtcm3_kepler_seen_]);
   for (; rtcm3_glonass_seen_ < r.glonass.size(); ++rtcm3_glonass_seen_) {
     nav_.glonass.push_back(r.glonass[rtcm3_glonass_seen_]);
   }
   for (; ubx_kepler_seen_ < u.kepler.size(); ++ubx_kepler_seen_) nav_.kepler.push_back(u.kepler[ubx_kepler_seen_]);
-  for (; ubx_glonass_seen_ < u.glonass.size(); ++ubx_glonass_seen_) nav_.glonass.push_back(u.glonass[ubx_glonass_seen_]);
+  for (; ubx_glonass_seen_ < u.glonass.size(); ++ubx_glonass_seen_)
+    nav_.glonass.push_back(u.glonass[ubx_glonass_seen_]);
 }
 
 GnssStreamStats GnssStreamDecoder::stats() const {
@@ -138,8 +140,8 @@ Result<std::vector<std::uint8_t>> read_binary_file(const std::string& path, std:
   const std::string text = message != nullptr ? message : "";
   gzclose(file);
   if (cut && warning != nullptr) {
-    *warning = path + ": compressed stream ended unexpectedly (" + text + "); " + std::to_string(out.size()) +
-               " bytes read";
+    *warning =
+        path + ": compressed stream ended unexpectedly (" + text + "); " + std::to_string(out.size()) + " bytes read";
   }
   return out;
 }

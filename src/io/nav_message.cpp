@@ -114,7 +114,9 @@ bool GlonassAssembler::hamming_ok(const String& str) {
   // Bit b_k (k = 85 .. 1) is at index 85 - k. Data bits b9..b85 take the Hamming positions 3, 5, 6, 7, 9, ...
   // (the integers that are not powers of two); check bit beta_k (= b_k, k = 1..7) covers the positions with bit
   // k - 1 set; beta_8 (b8) makes the parity of the whole string even.
-  auto bit = [&](int k) { return static_cast<unsigned>(get_bits(str.data(), str.size(), static_cast<std::size_t>(85 - k), 1)); };
+  auto bit = [&](int k) {
+    return static_cast<unsigned>(get_bits(str.data(), str.size(), static_cast<std::size_t>(85 - k), 1));
+  };
   std::array<unsigned, 7> syndrome{};
   for (int k = 1; k <= 7; ++k) syndrome[static_cast<std::size_t>(k - 1)] = bit(k);
   int position = 2;
@@ -132,8 +134,8 @@ bool GlonassAssembler::hamming_ok(const String& str) {
 }
 
 Result<std::optional<core::GlonassEphemeris>> GlonassAssembler::add(int slot, int channel, const String& str,
-                                                                   const GpsTime& reference,
-                                                                   const core::LeapSecondTable& leaps) {
+                                                                    const GpsTime& reference,
+                                                                    const core::LeapSecondTable& leaps) {
   if (!hamming_ok(str)) return Error{"GLONASS R" + std::to_string(slot) + ": string fails its Hamming code"};
   const auto m = static_cast<int>(u(str, 1, 4));
   if (m < 1 || m > 4) return std::optional<core::GlonassEphemeris>{};
@@ -230,7 +232,7 @@ Result<std::optional<GalileoInavAssembler::Word>> GalileoInavAssembler::word_fro
 }
 
 Result<std::optional<core::KeplerEphemeris>> GalileoInavAssembler::add(int svid, const Word& word,
-                                                                      const GpsTime& reference) {
+                                                                       const GpsTime& reference) {
   const auto type = static_cast<int>(u(word, 0, 6));
   if (type < 1 || type > 5) return std::optional<core::KeplerEphemeris>{};
   State& st = state_[svid];
@@ -249,7 +251,8 @@ Result<std::optional<core::KeplerEphemeris>> GalileoInavAssembler::add(int svid,
       u(w4, 6, 10) != static_cast<std::uint64_t>(iod)) {
     return std::optional<core::KeplerEphemeris>{};
   }
-  if (static_cast<int>(u(w4, 16, 6)) != svid) return Error{"Galileo E" + std::to_string(svid) + ": word 4 of another SVID"};
+  if (static_cast<int>(u(w4, 16, 6)) != svid)
+    return Error{"Galileo E" + std::to_string(svid) + ": word 4 of another SVID"};
   core::KeplerEphemeris e;
   e.sat = core::SatelliteId{Constellation::Galileo, static_cast<std::uint8_t>(svid)};
   e.iode = iod;
@@ -298,7 +301,7 @@ Result<std::optional<core::KeplerEphemeris>> GalileoInavAssembler::add(int svid,
 // BeiDou D1.
 
 Result<std::optional<core::KeplerEphemeris>> BeidouD1Assembler::add(int prn, const Subframe& f,
-                                                                   const GpsTime& reference) {
+                                                                    const GpsTime& reference) {
   // Data bits without parity: word 1 bits 0-25, words 2-10 the first 22 of their 30 bits.
   std::array<std::uint8_t, 28> d{};
   {
@@ -326,7 +329,8 @@ Result<std::optional<core::KeplerEphemeris>> BeidouD1Assembler::add(int prn, con
   e.health = static_cast<int>(u(d1, 38, 1));
   e.iodc = static_cast<int>(u(d1, 39, 5));
   e.accuracy_m = rtcm3::ura_m(static_cast<int>(u(d1, 44, 4)));
-  const int bdt_week = core::resolve_week_rollover(static_cast<int>(u(d1, 48, 13)), 13, core::gps_to_bdt(reference).week);
+  const int bdt_week =
+      core::resolve_week_rollover(static_cast<int>(u(d1, 48, 13)), 13, core::gps_to_bdt(reference).week);
   const double toc_s = static_cast<double>(u(d1, 61, 17)) * 8.0;
   e.tgd_s[0] = s(d1, 78, 10) * 1e-10;
   e.tgd_s[1] = s(d1, 88, 10) * 1e-10;

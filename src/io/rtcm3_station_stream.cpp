@@ -17,7 +17,7 @@ long long toe_key(const core::GpsTime& t) {
 }  // namespace
 
 std::string Rtcm3StationStreamOptions::validate() const {
-  if (const std::string e = encoder.validate(); !e.empty()) return e;
+  if (std::string e = encoder.validate(); !e.empty()) return e;
   if (!(station_interval_s >= 0.0)) return "station message interval must be >= 0 s";
   if (!(ephemeris_interval_s >= 0.0)) return "ephemeris interval must be >= 0 s";
   return {};
@@ -50,7 +50,7 @@ Result<std::vector<Rtcm3Frame>> Rtcm3StationStream::epoch(const core::ObsEpoch& 
   const core::GpsTime t = epoch.time;
   // Station messages.
   const bool station_due = !station_sent_at_ || (options_.station_interval_s > 0.0 &&
-                                                  t - *station_sent_at_ >= options_.station_interval_s - 1e-6);
+                                                 t - *station_sent_at_ >= options_.station_interval_s - 1e-6);
   if (station_due && (station_ || antenna_)) {
     if (station_) {
       auto f = encoder_.encode_station(*station_);
@@ -72,17 +72,18 @@ Result<std::vector<Rtcm3Frame>> Rtcm3StationStream::epoch(const core::ObsEpoch& 
   if (options_.send_ephemerides) {
     update_current(t);
     for (const core::SatelliteObs& so : epoch.sats) {
-      for (auto it = slots_.lower_bound({so.sat.index(), 0});
-           it != slots_.end() && it->first.first == so.sat.index(); ++it) {
+      for (auto it = slots_.lower_bound({so.sat.index(), 0}); it != slots_.end() && it->first.first == so.sat.index();
+           ++it) {
         Slot& slot = it->second;
-        const long long key = slot.kepler ? toe_key(slot.kepler->toe) : (slot.glonass ? toe_key(slot.glonass->toe) : -1);
+        const long long key =
+            slot.kepler ? toe_key(slot.kepler->toe) : (slot.glonass ? toe_key(slot.glonass->toe) : -1);
         if (key < 0) continue;
         const bool changed = key != slot.sent_key;
         const bool repeat = options_.ephemeris_interval_s > 0.0 && slot.sent_at &&
                             t - *slot.sent_at >= options_.ephemeris_interval_s - 1e-6;
         if (!changed && !repeat) continue;
-        Result<Rtcm3Frame> f = slot.kepler ? encoder_.encode_ephemeris(*slot.kepler)
-                                           : encoder_.encode_ephemeris(*slot.glonass);
+        Result<Rtcm3Frame> f =
+            slot.kepler ? encoder_.encode_ephemeris(*slot.kepler) : encoder_.encode_ephemeris(*slot.glonass);
         slot.sent_key = key;
         slot.sent_at = t;
         if (!f) {

@@ -164,11 +164,12 @@ std::optional<core::SignalCode> signal_code(int gnss_id, int sig_id, int rawx_ve
 }
 
 Result<Rawx> decode_rawx(std::span<const std::uint8_t> p) {
-  if (p.size() < kRawxHeader) return Error{"UBX RXM-RAWX: " + std::to_string(p.size()) + " bytes, shorter than its header"};
+  if (p.size() < kRawxHeader)
+    return Error{"UBX RXM-RAWX: " + std::to_string(p.size()) + " bytes, shorter than its header"};
   Rawx r;
   r.rcv_tow_s = r8(p, 0);
   r.week = u2(p, 8);
-  r.leap_s = static_cast<std::int8_t>(u1(p, 10));
+  r.leap_s = u1(p, 10) >= 128 ? u1(p, 10) - 256 : u1(p, 10);
   const std::size_t n = u1(p, 11);
   r.rec_stat = u1(p, 12);
   r.version = u1(p, 13);
@@ -230,7 +231,8 @@ std::vector<std::uint8_t> encode_rawx(const Rawx& r) {
 }
 
 Result<Sfrbx> decode_sfrbx(std::span<const std::uint8_t> p) {
-  if (p.size() < kSfrbxHeader) return Error{"UBX RXM-SFRBX: " + std::to_string(p.size()) + " bytes, shorter than its header"};
+  if (p.size() < kSfrbxHeader)
+    return Error{"UBX RXM-SFRBX: " + std::to_string(p.size()) + " bytes, shorter than its header"};
   Sfrbx s;
   s.gnss_id = u1(p, 0);
   s.sv_id = u1(p, 1);
@@ -247,10 +249,10 @@ Result<Sfrbx> decode_sfrbx(std::span<const std::uint8_t> p) {
 }
 
 std::vector<std::uint8_t> encode_sfrbx(const Sfrbx& s) {
-  std::vector<std::uint8_t> out = {static_cast<std::uint8_t>(s.gnss_id), static_cast<std::uint8_t>(s.sv_id),
-                                   static_cast<std::uint8_t>(s.sig_id),  static_cast<std::uint8_t>(s.freq_id),
+  std::vector<std::uint8_t> out = {static_cast<std::uint8_t>(s.gnss_id),      static_cast<std::uint8_t>(s.sv_id),
+                                   static_cast<std::uint8_t>(s.sig_id),       static_cast<std::uint8_t>(s.freq_id),
                                    static_cast<std::uint8_t>(s.words.size()), 0,
-                                   static_cast<std::uint8_t>(s.version), 0};
+                                   static_cast<std::uint8_t>(s.version),      0};
   for (const std::uint32_t w : s.words) put_u4(out, w);
   return out;
 }
@@ -287,7 +289,7 @@ Result<NavTimeGps> decode_nav_timegps(std::span<const std::uint8_t> p) {
   t.itow_ms = u4(p, 0);
   t.ftow_ns = i4(p, 4);
   t.week = static_cast<std::int16_t>(u2(p, 8));
-  t.leap_s = static_cast<std::int8_t>(u1(p, 10));
+  t.leap_s = u1(p, 10) >= 128 ? u1(p, 10) - 256 : u1(p, 10);
   t.valid = u1(p, 11);
   t.t_acc_ns = u4(p, 12);
   return t;
@@ -410,7 +412,8 @@ Status UbxDecoder::add_sfrbx(const ubx::Sfrbx& s, Message& out) {
     case core::Constellation::Glonass: {
       if (s.words.size() != 4) return Ok{};
       navmsg::GlonassAssembler::String str{};
-      for (std::size_t i = 0; i < str.size(); ++i) str[i] = static_cast<std::uint8_t>(s.words[i / 4] >> (24 - 8 * (i % 4)));
+      for (std::size_t i = 0; i < str.size(); ++i)
+        str[i] = static_cast<std::uint8_t>(s.words[i / 4] >> (24 - 8 * (i % 4)));
       str[10] &= 0xF8;  // 85 bits: the first five of byte 10
       const int channel = s.freq_id <= 13 ? s.freq_id - 7 : core::kNoGlonassChannel;
       if (channel != core::kNoGlonassChannel) glonass_channel_[sat->prn] = channel;
@@ -466,7 +469,8 @@ Status UbxDecoder::add_sfrbx(const ubx::Sfrbx& s, Message& out) {
   return Ok{};
 }
 
-Result<UbxDecoder::Message> UbxDecoder::decode(std::uint8_t cls, std::uint8_t id, std::span<const std::uint8_t> payload) {
+Result<UbxDecoder::Message> UbxDecoder::decode(std::uint8_t cls, std::uint8_t id,
+                                               std::span<const std::uint8_t> payload) {
   Message out;
   out.cls = cls;
   out.id = id;

@@ -51,8 +51,7 @@ class GlonassAssembler {
   /// Adds string 1-5 of a satellite (`channel`: its FDMA channel) received at `reference`. An ephemeris when strings
   /// 1-4 of one frame (received within 30 s) are there. Error for a string whose Hamming code fails.
   Result<std::optional<core::GlonassEphemeris>> add(int slot, int channel, const String& s,
-                                                    const core::GpsTime& reference,
-                                                    const core::LeapSecondTable& leaps);
+                                                    const core::GpsTime& reference, const core::LeapSecondTable& leaps);
 
  private:
   struct State {

@@ -29,7 +29,7 @@ struct Rtcm3StationStreamOptions {
 };
 
 struct Rtcm3StationStreamReport {
-  Rtcm3EncodeReport observations;   ///< summed over epochs
+  Rtcm3EncodeReport observations;  ///< summed over epochs
   int station_messages = 0;
   int ephemeris_messages = 0;
   std::vector<std::string> warnings;  ///< ephemerides that could not be encoded (first ones)

@@ -8,11 +8,11 @@
 //  - pseudorange if trkStat bit 0 (prValid); carrier phase if trkStat bit 1 (cpValid) and cpStdev <= 5 (0.02 cycle);
 //    Doppler and C/N0 always. Signals: RAWX version 0 (u-blox 8) has no signal id: GPS/QZSS/GLONASS L1 C/A "1C",
 //    Galileo E1 "1X", BeiDou B1I "2I"; version 1 (F9) maps sigId (GPS L1C/A 1C, L2CL 2L, L2CM 2S, L5I 5I, L5Q 5Q;
-//    Galileo E1C 1C, E1B 1B, E5aI 5I, E5aQ 5Q, E5bI 7I, E5bQ 7Q; BeiDou B1I 2I, B2I 7I, B1Cp 1P, B2ap 5P; QZSS L1C/A 1C,
-//    L1S 1Z, L2CM 2S, L2CL 2L, L5I 5I, L5Q 5Q; GLONASS L1OF 1C, L2OF 2C). SBAS and IRNSS measurements are skipped.
+//    Galileo E1C 1C, E1B 1B, E5aI 5I, E5aQ 5Q, E5bI 7I, E5bQ 7Q; BeiDou B1I 2I, B2I 7I, B1Cp 1P, B2ap 5P; QZSS L1C/A
+//    1C, L1S 1Z, L2CM 2S, L2CL 2L, L5I 5I, L5Q 5Q; GLONASS L1OF 1C, L2OF 2C). SBAS and IRNSS measurements are skipped.
 //  - Loss of lock (LLI bit 0) at a signal's first epoch, when the lock time is 0 or smaller than at the previous
-//    epoch, or when the half-cycle subtraction state (trkStat bit 3) changed; a slip seen while the phase is invalid is kept for the next valid
-//    phase. LLI bit 1 (half cycle unresolved) when trkStat bit 2 (halfCyc valid) is clear.
+//    epoch, or when the half-cycle subtraction state (trkStat bit 3) changed; a slip seen while the phase is invalid is
+//    kept for the next valid phase. LLI bit 1 (half cycle unresolved) when trkStat bit 2 (halfCyc valid) is clear.
 //  - GLONASS FDMA channel: freqId - 7.
 // RXM-SFRBX -> ephemerides through the assemblers of nav_message.hpp: GPS/QZSS LNAV, GLONASS strings, Galileo I/NAV,
 // BeiDou D1 (GEO D2 pages are skipped). The receiver time of the last RAWX (or NAV-TIMEGPS) resolves weeks.
@@ -57,8 +57,8 @@ struct RawxMeasurement {
   int gnss_id = 0;
   int sv_id = 0;
   int sig_id = 0;
-  int freq_id = 0;          ///< GLONASS: channel + 7
-  int lock_time_ms = 0;     ///< carrier phase lock time (ms, capped at 64500)
+  int freq_id = 0;       ///< GLONASS: channel + 7
+  int lock_time_ms = 0;  ///< carrier phase lock time (ms, capped at 64500)
   int cno_dbhz = 0;
   double pr_stdev_m = 0.0;  ///< 0.01 * 2^n m
   int cp_stdev = 0;         ///< 0.004 cycle units (4 bits)
@@ -91,13 +91,13 @@ std::vector<std::uint8_t> encode_sfrbx(const Sfrbx& sfrbx);  ///< payload (tests
 struct NavPvt {
   std::uint32_t itow_ms = 0;
   int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
-  std::uint8_t valid = 0;    ///< bit 0 date, 1 time, 2 fully resolved
+  std::uint8_t valid = 0;  ///< bit 0 date, 1 time, 2 fully resolved
   std::int32_t nano_ns = 0;
-  int fix_type = 0;          ///< 0 none, 2 2D, 3 3D, 4 GNSS + dead reckoning, 5 time only
-  std::uint8_t flags = 0;    ///< bit 0 gnssFixOK; bits 6-7 carrier solution (1 float, 2 fixed)
+  int fix_type = 0;        ///< 0 none, 2 2D, 3 3D, 4 GNSS + dead reckoning, 5 time only
+  std::uint8_t flags = 0;  ///< bit 0 gnssFixOK; bits 6-7 carrier solution (1 float, 2 fixed)
   int num_sv = 0;
   double lon_deg = 0.0, lat_deg = 0.0;
-  double height_m = 0.0;     ///< above the ellipsoid
+  double height_m = 0.0;  ///< above the ellipsoid
   double height_msl_m = 0.0;
   double h_acc_m = 0.0, v_acc_m = 0.0;
   double vel_ned_mps[3] = {0.0, 0.0, 0.0};
