@@ -29,8 +29,8 @@ core::GpsTime now_gps() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   gmtime_r(&now, &utc);
-  const core::CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday, utc.tm_hour, utc.tm_min,
-                             static_cast<double>(utc.tm_sec)};
+  const core::CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                             utc.tm_hour,        utc.tm_min,     static_cast<double>(utc.tm_sec)};
   return core::utc_to_gps(c, core::builtin_leap_seconds());
 }
 
@@ -56,18 +56,16 @@ bool looks_like_rinex(const std::vector<std::uint8_t>& bytes) {
 
 std::string counts_line(const io::GnssStreamStats& s) {
   char text[512];
-  std::snprintf(text, sizeof text,
-                "%llu bytes: %llu RTCM 3 frames, %llu UBX packets, %llu NMEA sentences; %llu bad RTCM 3 CRCs, %llu bad "
-                "UBX checksums, %llu truncated, %llu garbage bytes; %llu RTCM 3 and %llu UBX messages undecodable",
-                static_cast<unsigned long long>(s.framing.bytes), static_cast<unsigned long long>(s.framing.rtcm3_frames),
-                static_cast<unsigned long long>(s.framing.ubx_packets),
-                static_cast<unsigned long long>(s.framing.nmea_sentences),
-                static_cast<unsigned long long>(s.framing.rtcm3_bad_crc),
-                static_cast<unsigned long long>(s.framing.ubx_bad_checksum),
-                static_cast<unsigned long long>(s.framing.truncated),
-                static_cast<unsigned long long>(s.framing.garbage_bytes),
-                static_cast<unsigned long long>(s.rtcm3_decode_errors),
-                static_cast<unsigned long long>(s.ubx_decode_errors));
+  std::snprintf(
+      text, sizeof text,
+      "%llu bytes: %llu RTCM 3 frames, %llu UBX packets, %llu NMEA sentences; %llu bad RTCM 3 CRCs, %llu bad "
+      "UBX checksums, %llu truncated, %llu garbage bytes; %llu RTCM 3 and %llu UBX messages undecodable",
+      static_cast<unsigned long long>(s.framing.bytes), static_cast<unsigned long long>(s.framing.rtcm3_frames),
+      static_cast<unsigned long long>(s.framing.ubx_packets), static_cast<unsigned long long>(s.framing.nmea_sentences),
+      static_cast<unsigned long long>(s.framing.rtcm3_bad_crc),
+      static_cast<unsigned long long>(s.framing.ubx_bad_checksum), static_cast<unsigned long long>(s.framing.truncated),
+      static_cast<unsigned long long>(s.framing.garbage_bytes), static_cast<unsigned long long>(s.rtcm3_decode_errors),
+      static_cast<unsigned long long>(s.ubx_decode_errors));
   return text;
 }
 
@@ -101,8 +99,9 @@ Result<ConvertSummary> binary_to_rinex(const ConvertConfig& config, const std::v
     const auto dated = stream_date(bytes, now);
     o.rtcm3.reference_time = dated.value_or(now);
     if (!dated) {
-      warnings.push_back("no ephemeris in the input dates it: RTCM 3 weeks are resolved against the current date "
-                         "(give --time for older data)");
+      warnings.emplace_back(
+          "no ephemeris in the input dates it: RTCM 3 weeks are resolved against the current date "
+          "(give --time for older data)");
     }
   }
   io::GnssStreamDecoder decoder(o);
@@ -135,7 +134,8 @@ Result<ConvertSummary> binary_to_rinex(const ConvertConfig& config, const std::v
   if (station && !use_ubx) {
     header.receiver.approx_position_E_m = station->arp_E_m;
     if (station->antenna_height_m) header.receiver.antenna_delta_hen_m.x() = *station->antenna_height_m;
-    if (header.receiver.marker_name.empty()) header.receiver.marker_name = "RTCM " + std::to_string(station->station_id);
+    if (header.receiver.marker_name.empty())
+      header.receiver.marker_name = "RTCM " + std::to_string(station->station_id);
   }
   if (const auto& antenna = decoder.rtcm3().antenna(); antenna && !use_ubx) {
     header.receiver.antenna_type = antenna->antenna_descriptor;
@@ -144,7 +144,8 @@ Result<ConvertSummary> binary_to_rinex(const ConvertConfig& config, const std::v
   if (header.receiver.marker_name.empty()) {
     header.receiver.marker_name = std::filesystem::path(sibling(config.input, "")).stem().string();
   }
-  header.receiver.glonass_slot_channels = use_ubx ? decoder.ubx().glonass_channels() : decoder.rtcm3().glonass_channels();
+  header.receiver.glonass_slot_channels =
+      use_ubx ? decoder.ubx().glonass_channels() : decoder.rtcm3().glonass_channels();
   const core::NavigationData nav = decoder.navigation();
   for (const core::GlonassEphemeris& g : nav.glonass) {
     bool known = false;
@@ -196,7 +197,7 @@ Result<ConvertSummary> rinex_to_rtcm(const ConvertConfig& config, std::vector<st
     station.arp_E_m = *position;
     stream.set_station(station);
   } else {
-    warnings.push_back("no station position (header APPROX POSITION XYZ is zero, no --position): no 1005 sent");
+    warnings.emplace_back("no station position (header APPROX POSITION XYZ is zero, no --position): no 1005 sent");
   }
   const std::string out_path = config.rtcm_out.empty() ? sibling(config.input, ".rtcm3") : config.rtcm_out;
   std::ofstream out(out_path, std::ios::binary);

@@ -27,20 +27,20 @@
 namespace canyon::app {
 
 struct ConvertConfig {
-  std::string input;            ///< input file ("-": standard input)
-  std::string from = "auto";    ///< auto | rtcm3 | ubx | rinex
+  std::string input;          ///< input file ("-": standard input)
+  std::string from = "auto";  ///< auto | rtcm3 | ubx | rinex
   // Binary -> RINEX.
-  std::string obs_out;          ///< RINEX observations (default: the input name with .obs)
-  std::string nav_out;          ///< RINEX navigation (default: the input name with .nav)
+  std::string obs_out;                       ///< RINEX observations (default: the input name with .obs)
+  std::string nav_out;                       ///< RINEX navigation (default: the input name with .nav)
   std::optional<core::GpsTime> approx_time;  ///< GPST within a few days of the data (RTCM 3 weeks)
-  std::string marker;           ///< RINEX MARKER NAME (default: "RTCM <station id>" or the input name)
+  std::string marker;                        ///< RINEX MARKER NAME (default: "RTCM <station id>" or the input name)
   // RINEX -> RTCM 3.
-  std::string rtcm_out;         ///< RTCM 3 output (default: the input name with .rtcm3)
-  std::vector<std::string> nav;  ///< RINEX navigation files whose ephemerides go into the stream
-  int station_id = 0;           ///< DF003, 0-4095
-  int msm = 7;                  ///< 4 or 7 (5 and 6 also accepted)
-  double station_interval_s = 10.0;    ///< 1005 every this many seconds (0: once)
-  double ephemeris_interval_s = 0.0;   ///< repeat current ephemerides (0: each once, when it becomes current)
+  std::string rtcm_out;                         ///< RTCM 3 output (default: the input name with .rtcm3)
+  std::vector<std::string> nav;                 ///< RINEX navigation files whose ephemerides go into the stream
+  int station_id = 0;                           ///< DF003, 0-4095
+  int msm = 7;                                  ///< 4 or 7 (5 and 6 also accepted)
+  double station_interval_s = 10.0;             ///< 1005 every this many seconds (0: once)
+  double ephemeris_interval_s = 0.0;            ///< repeat current ephemerides (0: each once, when it becomes current)
   std::optional<Eigen::Vector3d> position_E_m;  ///< 1005 antenna reference point (default: header position)
 
   /// Empty if valid, else the violated rule.
@@ -48,13 +48,13 @@ struct ConvertConfig {
 };
 
 struct ConvertSummary {
-  std::string direction;               ///< "rtcm3 -> rinex", "ubx -> rinex", "rinex -> rtcm3"
+  std::string direction;  ///< "rtcm3 -> rinex", "ubx -> rinex", "rinex -> rtcm3"
   int epochs = 0;
   int ephemerides = 0;
-  int messages = 0;                    ///< RTCM 3 frames written (rinex -> rtcm3)
-  std::vector<std::string> written;    ///< files written
-  std::vector<std::string> warnings;   ///< recovered problems (framing, decode errors with byte offsets, ...)
-  std::string statistics;              ///< one line of counts (frames, bad CRCs, garbage bytes, ...)
+  int messages = 0;                   ///< RTCM 3 frames written (rinex -> rtcm3)
+  std::vector<std::string> written;   ///< files written
+  std::vector<std::string> warnings;  ///< recovered problems (framing, decode errors with byte offsets, ...)
+  std::string statistics;             ///< one line of counts (frames, bad CRCs, garbage bytes, ...)
 };
 
 /// Runs the conversion. Error (file, and byte or line) if the input cannot be read or an output cannot be written.
