@@ -2,6 +2,8 @@
 
 #include "canyon/app/convert.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -69,6 +71,27 @@ std::string counts_line(const io::GnssStreamStats& s) {
   return text;
 }
 
+/// Merges consecutive epochs of the same time (within 0.5 ms) into one; a satellite given twice keeps its first.
+void merge_same_time(std::vector<core::ObsEpoch>& epochs) {
+  std::vector<core::ObsEpoch> merged;
+  merged.reserve(epochs.size());
+  for (core::ObsEpoch& e : epochs) {
+    if (!merged.empty() && std::abs(merged.back().time - e.time) < 5e-4) {
+      core::ObsEpoch& into = merged.back();
+      for (core::SatelliteObs& s : e.sats) {
+        const bool known = std::any_of(into.sats.begin(), into.sats.end(),
+                                       [&](const core::SatelliteObs& o) { return o.sat == s.sat; });
+        if (!known) into.sats.push_back(std::move(s));
+      }
+      std::sort(into.sats.begin(), into.sats.end(),
+                [](const core::SatelliteObs& a, const core::SatelliteObs& b) { return a.sat < b.sat; });
+      continue;
+    }
+    merged.push_back(std::move(e));
+  }
+  epochs = std::move(merged);
+}
+
 /// The first ephemeris of the stream that dates it (any toe, resolved against `now`).
 std::optional<core::GpsTime> stream_date(const std::vector<std::uint8_t>& bytes, const core::GpsTime& now) {
   io::GnssStreamOptions o;
@@ -117,6 +140,9 @@ Result<ConvertSummary> binary_to_rinex(const ConvertConfig& config, const std::v
     warnings.push_back("the input also holds " + std::to_string(rtcm_epochs.size()) +
                        " RTCM 3 observation epochs, not converted (--from rtcm3 converts them instead)");
   }
+  // Receivers that clear the multiple message bit on every MSM (u-blox) split an epoch into one per constellation:
+  // a file is written with one record per epoch time.
+  merge_same_time(rtcm_epochs);
   std::vector<core::ObsEpoch>& epochs = use_ubx ? ubx_epochs : rtcm_epochs;
   summary.direction = use_ubx ? "ubx -> rinex" : "rtcm3 -> rinex";
   summary.epochs = static_cast<int>(epochs.size());

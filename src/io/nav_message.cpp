@@ -34,9 +34,15 @@ double sm(const std::array<std::uint8_t, N>& a, std::size_t pos, unsigned n) {
   return static_cast<double>(get_bits_sign_magnitude(a.data(), N, pos, n));
 }
 
-/// `t` moved by whole weeks to within half a week of `reference`.
+/// `t` moved by one week towards `reference` when it is more than half a week (and less than a week and a half) away:
+/// a message's week may be that of its transmission rather than of toe. Farther is a date question the week number
+/// answers, not this.
 GpsTime nearest_week(GpsTime t, const GpsTime& reference) {
-  return t - std::round((t - reference) / core::kSecondsPerWeek) * core::kSecondsPerWeek;
+  const double d = t - reference;
+  constexpr double kHalf = core::kSecondsPerWeek / 2.0;
+  if (d > kHalf && d < 3 * kHalf) return t - double(core::kSecondsPerWeek);
+  if (d < -kHalf && d > -3 * kHalf) return t + double(core::kSecondsPerWeek);
+  return t;
 }
 
 long long toe_key(const GpsTime& toe) {

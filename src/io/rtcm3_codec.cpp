@@ -378,6 +378,10 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
         }
         cell.phase_range_m = phase_m;
         cell.lock_time_ms = std::max(0.0, (epoch.time - arc.start) * 1000.0);
+      } else if (const auto it = arcs_.find(SignalKey{so.sat.index(), s.code.band, s.code.attribute});
+                 it != arcs_.end() && it->second.valid) {
+        // No phase this epoch, but the arc goes on (no loss of lock reported): its lock time keeps growing.
+        cell.lock_time_ms = std::max(0.0, (epoch.time - it->second.start) * 1000.0);
       }
       ms.cells.push_back(cell);
     }

@@ -2,6 +2,7 @@
 // I/NAV (RTCM 10403.3 tables 3.5-21, 3.5-22, and the 1042/1044/1045/1046 tables of amendments 1-2).
 // Angles are sent in semicircles: converted with the ICD's pi (kGpsPi).
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -14,9 +15,12 @@ namespace {
 using core::Constellation;
 using core::GpsTime;
 
-constexpr std::array<double, 15> kUraM = {2.4,  3.4,   4.85,  6.85,  9.65,   13.65,  24.0,  48.0,
-                                          96.0, 192.0, 384.0, 768.0, 1536.0, 3072.0, 6144.0};
-constexpr double kNoUraM = 32767.0;
+// URA index N (IS-GPS-200 20.3.3.3.1.3): upper bounds of the accuracy ranges (encoding: the first range that holds
+// the value) and the nominal values X the ICD gives users (decoding; RINEX writers, RTKLIB's too, write these).
+constexpr std::array<double, 15> kUraUpperM = {2.4,  3.4,   4.85,  6.85,  9.65,   13.65,  24.0,  48.0,
+                                               96.0, 192.0, 384.0, 768.0, 1536.0, 3072.0, 6144.0};
+constexpr std::array<double, 16> kUraNominalM = {2.0,  2.8,   4.0,   5.7,   8.0,    11.3,   16.0,   32.0,
+                                                 64.0, 128.0, 256.0, 512.0, 1024.0, 2048.0, 4096.0, 8192.0};
 
 double p2(int e) {
   return std::ldexp(1.0, e);
@@ -88,10 +92,15 @@ double system_sow(const GpsTime& t, Constellation system) {
   return system == Constellation::BeiDou ? core::gps_to_bdt(t).tow_s : t.normalized().tow_s;
 }
 
-/// `t` moved by whole weeks to within half a week of `reference`.
+/// `t` moved by one week towards `reference` when it is more than half a week (and less than a week and a half) away:
+/// a message's week may be that of its transmission rather than of toe. Farther is a date question the week number
+/// answers, not this.
 GpsTime nearest_week(GpsTime t, const GpsTime& reference) {
-  const double weeks = std::round((t - reference) / core::kSecondsPerWeek);
-  return t - weeks * core::kSecondsPerWeek;
+  const double d = t - reference;
+  constexpr double kHalf = core::kSecondsPerWeek / 2.0;
+  if (d > kHalf && d < 3 * kHalf) return t - double(core::kSecondsPerWeek);
+  if (d < -kHalf && d > -3 * kHalf) return t + double(core::kSecondsPerWeek);
+  return t;
 }
 
 std::string short_text(int number, std::size_t bytes, unsigned bits) {
@@ -102,12 +111,12 @@ std::string short_text(int number, std::size_t bytes, unsigned bits) {
 }  // namespace
 
 double ura_m(int index) {
-  return index >= 0 && index < 15 ? kUraM[static_cast<std::size_t>(index)] : kNoUraM;
+  return kUraNominalM[static_cast<std::size_t>(std::clamp(index, 0, 15))];
 }
 
 int ura_index(double accuracy_m) {
-  for (std::size_t i = 0; i < kUraM.size(); ++i) {
-    if (kUraM[i] >= accuracy_m) return static_cast<int>(i);
+  for (std::size_t i = 0; i < kUraUpperM.size(); ++i) {
+    if (kUraUpperM[i] >= accuracy_m) return static_cast<int>(i);
   }
   return 15;
 }

@@ -385,7 +385,7 @@ core::KeplerEphemeris typical_kepler(core::SatelliteId sat, const GpsTime& toe) 
   e.iode = sat.system == Constellation::BeiDou ? 17 : 77;
   e.iodc = sat.system == Constellation::BeiDou ? 9 : 333;
   e.health = 0;
-  e.accuracy_m = sat.system == Constellation::Galileo ? 3.12 : 2.4;
+  e.accuracy_m = sat.system == Constellation::Galileo ? 3.12 : 2.0;
   e.data_source = sat.system == Constellation::Galileo ? 0x205 : 1;
   e.fit_interval_h = 4.0;
   return e;

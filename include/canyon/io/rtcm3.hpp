@@ -187,7 +187,9 @@ Result<core::GlonassEphemeris> decode_glonass_ephemeris(std::span<const std::uin
 /// The ephemeris message number for a satellite's record (0 if none).
 [[nodiscard]] int ephemeris_message_number(const core::KeplerEphemeris& eph);
 
-/// URA index (GPS/QZSS/BeiDou, 0-15) <-> metres; SISA index (Galileo, 0-255) <-> metres (255: no accuracy, -1).
+/// URA index (GPS/QZSS/BeiDou, 0-15) -> the ICD's nominal accuracy (2.0, 2.8, 4.0, 5.7, 8.0, 11.3, 16, 32 ... 8192
+/// m), and metres -> the index of the first range (upper bounds 2.4, 3.4, 4.85 ... 6144 m) that holds them; SISA
+/// index (Galileo, 0-255) <-> metres (255: no accuracy, -1).
 [[nodiscard]] double ura_m(int index);
 [[nodiscard]] int ura_index(double accuracy_m);
 [[nodiscard]] double sisa_m(int index);
