@@ -225,6 +225,7 @@ Result<std::optional<GalileoInavAssembler::Word>> GalileoInavAssembler::word_fro
     w.u(0, 4);
     for (std::size_t i = 0; i < 114; ++i) w.u(u(b, i, 1), 1);
     for (std::size_t i = 0; i < 82; ++i) w.u(u(b, 128 + i, 1), 1);
+    w.flush();
     std::copy(v.begin(), v.end(), crc_input.begin());
   }
   if (crc24q(crc_input) != u(b, 128 + 82, 24)) return Error{"Galileo I/NAV page pair fails its CRC"};
@@ -233,6 +234,7 @@ Result<std::optional<GalileoInavAssembler::Word>> GalileoInavAssembler::word_fro
   BitWriter w(v);
   for (std::size_t i = 0; i < 112; ++i) w.u(u(b, 2 + i, 1), 1);
   for (std::size_t i = 0; i < 16; ++i) w.u(u(b, 130 + i, 1), 1);
+  w.flush();
   std::copy(v.begin(), v.end(), word.begin());
   return std::optional<Word>{word};
 }
@@ -315,6 +317,7 @@ Result<std::optional<core::KeplerEphemeris>> BeidouD1Assembler::add(int prn, con
     BitWriter w(v);
     w.u(get_bits(f.data(), f.size(), 0, 26), 26);
     for (std::size_t k = 1; k < 10; ++k) w.u(get_bits(f.data(), f.size(), 30 * k, 22), 22);
+    w.flush();
     std::copy(v.begin(), v.end(), d.begin());
   }
   if (u(d, 0, 11) != 0x712) return Error{"BeiDou C" + std::to_string(prn) + ": D1 subframe without preamble"};

@@ -27,6 +27,7 @@ std::string satellite_text(const core::SatelliteId& sat) {
 
 Rtcm3Decoder::Rtcm3Decoder(Rtcm3DecoderOptions options)
     : options_(std::move(options)), reference_(options_.reference_time) {
+  slot_of_.fill(-1);
   for (const auto& [slot, channel] : options_.glonass_channels) glonass_channel_[slot] = channel;
 }
 
@@ -53,6 +54,9 @@ void Rtcm3Decoder::flush() {
 
 void Rtcm3Decoder::complete_epoch() {
   if (!assembling_) return;
+  for (const core::SatelliteObs& s : assembling_->sats) slot_of_[static_cast<std::size_t>(s.sat.index())] = -1;
+  // Satellites whose every signal was dropped (e.g. GLONASS phase without channel and no pseudorange).
+  std::erase_if(assembling_->sats, [](const core::SatelliteObs& s) { return s.signals.empty(); });
   std::sort(assembling_->sats.begin(), assembling_->sats.end(),
             [](const core::SatelliteObs& a, const core::SatelliteObs& b) { return a.sat < b.sat; });
   ready_.push_back(std::move(*assembling_));
@@ -70,16 +74,17 @@ void Rtcm3Decoder::begin_epoch(const core::GpsTime& time) {
 }
 
 core::SatelliteObs& Rtcm3Decoder::satellite(const core::SatelliteId& sat) {
-  for (core::SatelliteObs& s : assembling_->sats) {
-    if (s.sat == sat) return s;
+  int& slot = slot_of_[static_cast<std::size_t>(sat.index())];
+  if (slot < 0) {
+    slot = static_cast<int>(assembling_->sats.size());
+    assembling_->sats.push_back(core::SatelliteObs{sat, {}});
   }
-  assembling_->sats.push_back(core::SatelliteObs{sat, {}});
-  return assembling_->sats.back();
+  return assembling_->sats[static_cast<std::size_t>(slot)];
 }
 
 std::uint8_t Rtcm3Decoder::lock_lli(const core::SatelliteId& sat, core::SignalCode code, double lock_ms,
                                     double upper_ms, const core::GpsTime& time) {
-  LockState& state = locks_[SignalKey{sat.index(), code.band, code.attribute}];
+  LockState& state = locks_.at(sat, code);
   bool slip = lock_ms <= 0.0 || (state.seen && lock_ms < state.lock_ms);
   // A gap longer than the lock time can be: lock was lost in between.
   if (state.seen && (time - state.time) * 1000.0 > upper_ms + 1.0) slip = true;
@@ -96,6 +101,13 @@ Status Rtcm3Decoder::add_msm(const rtcm3::MsmMessage& msm, Message& out) {
   out.station_id = h.station_id;
   begin_epoch(time);
   const bool extended_lock = h.type >= 6;
+  // Code and wavelength of each signal id of this message (GLONASS: per satellite, below).
+  struct SignalInfo {
+    std::optional<core::SignalCode> code;
+    std::optional<double> lambda_m;
+    bool known = false;
+  };
+  std::array<SignalInfo, 33> info{};
   for (const rtcm3::MsmSatellite& s : msm.satellites) {
     core::SatelliteId sat{h.system, static_cast<std::uint8_t>(s.satellite_id)};
     if (!sat.valid()) {
@@ -111,7 +123,13 @@ Status Rtcm3Decoder::add_msm(const rtcm3::MsmMessage& msm, Message& out) {
     }
     core::SatelliteObs& obs = satellite(sat);
     for (const rtcm3::MsmCell& c : s.cells) {
-      const auto code = rtcm3::msm_signal_code(h.system, c.signal_id);
+      SignalInfo& si = info[static_cast<std::size_t>(c.signal_id)];
+      if (!si.known) {
+        si.code = rtcm3::msm_signal_code(h.system, c.signal_id);
+        if (si.code && h.system != Constellation::Glonass) si.lambda_m = core::wavelength_m(h.system, *si.code);
+        si.known = true;
+      }
+      const std::optional<core::SignalCode>& code = si.code;
       if (!code) {
         warn_once(std::string(core::constellation_name(h.system)) + " MSM signal id " + std::to_string(c.signal_id) +
                   " is reserved, skipped");
@@ -122,7 +140,8 @@ Status Rtcm3Decoder::add_msm(const rtcm3::MsmMessage& msm, Message& out) {
       sig.code = *code;
       sig.pseudorange_m = c.pseudorange_m;
       sig.snr_dbhz = c.cnr_dbhz;
-      const auto lambda = core::wavelength_m(h.system, *code, channel);
+      const std::optional<double> lambda =
+          h.system == Constellation::Glonass ? core::wavelength_m(h.system, *code, channel) : si.lambda_m;
       if (lambda) {
         if (core::has_value(c.phase_range_m)) sig.carrier_phase_cyc = c.phase_range_m / *lambda;
         if (core::has_value(c.phase_range_rate_mps)) sig.doppler_hz = -c.phase_range_rate_mps / *lambda;
@@ -132,8 +151,7 @@ Status Rtcm3Decoder::add_msm(const rtcm3::MsmMessage& msm, Message& out) {
                   "(send MSM5/MSM7 or 1020, or give the channels)");
       }
       if (core::has_value(sig.carrier_phase_cyc)) {
-        const int indicator = rtcm3::msm_lock_indicator(c.lock_time_ms, extended_lock);
-        const double upper_ms = rtcm3::msm_lock_time_ms(indicator + 1, extended_lock);
+        const double upper_ms = rtcm3::msm_lock_time_ms(c.lock_indicator + 1, extended_lock);
         sig.lli = lock_lli(sat, *code, c.lock_time_ms, upper_ms, time);
         if (c.half_cycle) sig.lli |= core::kLliHalfCycle;
       }
@@ -141,11 +159,6 @@ Status Rtcm3Decoder::add_msm(const rtcm3::MsmMessage& msm, Message& out) {
           core::has_value(sig.doppler_hz)) {
         obs.signals.push_back(sig);
       }
-    }
-    if (obs.signals.empty()) {
-      assembling_->sats.erase(std::remove_if(assembling_->sats.begin(), assembling_->sats.end(),
-                                             [&](const core::SatelliteObs& o) { return o.sat == sat; }),
-                              assembling_->sats.end());
     }
   }
   if (!h.multiple_message) complete_epoch();
@@ -178,7 +191,7 @@ Status Rtcm3Decoder::add_legacy(const rtcm3::LegacyObsMessage& m, Message& out) 
       const auto lambda = core::wavelength_m(m.system, l.code, channel);
       if (lambda && core::has_value(l.phase_range_m)) {
         double cyc = l.phase_range_m / *lambda;
-        LockState& state = locks_[SignalKey{s.sat.index(), l.code.band, l.code.attribute}];
+        LockState& state = locks_.at(s.sat, l.code);
         // The phase-range field rolls over by 1500 cycles: keep the phase continuous with the previous epoch.
         if (core::has_value(state.last_phase_cyc)) {
           cyc += kLegacyPhaseRollCyc * std::round((state.last_phase_cyc - cyc) / kLegacyPhaseRollCyc);
@@ -186,7 +199,7 @@ Status Rtcm3Decoder::add_legacy(const rtcm3::LegacyObsMessage& m, Message& out) 
         sig.carrier_phase_cyc = cyc;
         const double lock_ms = l.lock_time_s * 1000.0;
         sig.lli = lock_lli(s.sat, l.code, lock_ms, std::max(2.0 * lock_ms, 1000.0), time);
-        locks_[SignalKey{s.sat.index(), l.code.band, l.code.attribute}].last_phase_cyc = cyc;
+        locks_.at(s.sat, l.code).last_phase_cyc = cyc;
       }
       obs.signals.push_back(sig);
     }
@@ -205,10 +218,9 @@ Result<Rtcm3Decoder::Message> Rtcm3Decoder::decode(std::span<const std::uint8_t>
   out.number = rtcm3::message_number(payload);
   const int n = out.number;
   if (rtcm3::msm_kind(n)) {
-    auto msm = rtcm3::decode_msm(payload);
-    if (!msm) return msm.error();
+    if (Status s = rtcm3::decode_msm(payload, msm_); !s.ok()) return s.error();
     out.content = Content::Observations;
-    if (Status s = add_msm(*msm, out); !s.ok()) return s.error();
+    if (Status s = add_msm(msm_, out); !s.ok()) return s.error();
   } else if (n == 1004 || n == 1012) {
     auto legacy = rtcm3::decode_legacy_obs(payload);
     if (!legacy) return legacy.error();
@@ -325,7 +337,8 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
   Rtcm3EncodeReport report;
 
   // Satellites per constellation, in satellite order.
-  std::array<std::vector<rtcm3::MsmSatellite>, core::kNumConstellations> per_system;
+  auto& per_system = per_system_;
+  for (auto& v : per_system) v.clear();
   for (const core::SatelliteObs& so : epoch.sats) {
     const Constellation system = so.sat.system;
     int channel = core::kNoGlonassChannel;
@@ -362,7 +375,7 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
       if (lambda && core::has_value(s.doppler_hz)) cell.phase_range_rate_mps = -s.doppler_hz * *lambda;
       if (lambda && core::has_value(s.carrier_phase_cyc) && core::has_value(reference_m)) {
         const double own_m = core::has_value(s.pseudorange_m) ? s.pseudorange_m : reference_m;
-        Arc& arc = arcs_[SignalKey{so.sat.index(), s.code.band, s.code.attribute}];
+        Arc& arc = arcs_.at(so.sat, s.code);
         const bool slip = (s.lli & core::kLliLossOfLock) != 0;
         auto start_arc = [&]() {
           arc.offset_cyc = std::round(s.carrier_phase_cyc - own_m / *lambda);
@@ -378,10 +391,9 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
         }
         cell.phase_range_m = phase_m;
         cell.lock_time_ms = std::max(0.0, (epoch.time - arc.start) * 1000.0);
-      } else if (const auto it = arcs_.find(SignalKey{so.sat.index(), s.code.band, s.code.attribute});
-                 it != arcs_.end() && it->second.valid) {
+      } else if (const Arc* arc = arcs_.find(so.sat, s.code); arc != nullptr && arc->valid) {
         // No phase this epoch, but the arc goes on (no loss of lock reported): its lock time keeps growing.
-        cell.lock_time_ms = std::max(0.0, (epoch.time - it->second.start) * 1000.0);
+        cell.lock_time_ms = std::max(0.0, (epoch.time - arc->start) * 1000.0);
       }
       ms.cells.push_back(cell);
     }
@@ -426,8 +438,8 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
     msm.header.epoch_time = rtcm3::msm_epoch_field(p.system, epoch.time, options_.leaps);
     msm.header.multiple_message = i + 1 < pending.size();
     auto& sats = per_system[static_cast<std::size_t>(p.system)];
-    msm.satellites.assign(std::make_move_iterator(sats.begin() + static_cast<std::ptrdiff_t>(p.first)),
-                          std::make_move_iterator(sats.begin() + static_cast<std::ptrdiff_t>(p.first + p.count)));
+    msm.satellites.assign(sats.begin() + static_cast<std::ptrdiff_t>(p.first),
+                          sats.begin() + static_cast<std::ptrdiff_t>(p.first + p.count));
     payload_.clear();
     auto encoded = rtcm3::append_msm(msm, payload_);
     if (!encoded) return encoded.error();

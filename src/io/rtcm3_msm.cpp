@@ -36,7 +36,7 @@ constexpr SignalTable kBeidouSignals = {"",   "2I", "2Q", "2X", "",   "", "", "6
                                         "",   "",   "7I", "7Q", "7X", "", "", "",   "",   "",   "5D",
                                         "5P", "5X", "7D", "",   "",   "", "", "1D", "1P", "1X"};
 
-const SignalTable& signal_table(Constellation system) {
+constexpr const SignalTable& signal_table(Constellation system) {
   switch (system) {
     case Constellation::Gps: return kGpsSignals;
     case Constellation::Glonass: return kGlonassSignals;
@@ -81,15 +81,15 @@ Layout layout(int type) {
   l.high_res = type >= 6;
   if (l.high_res) {
     l.pr_bits = 20;
-    l.pr_lsb_ms = std::ldexp(1.0, -29);
+    l.pr_lsb_ms = 1.0 / 536870912.0;  // 2^-29
     l.ph_bits = 24;
-    l.ph_lsb_ms = std::ldexp(1.0, -31);
+    l.ph_lsb_ms = 1.0 / 2147483648.0;  // 2^-31
     l.lock_bits = 10;
     l.cnr_bits = 10;
     l.cnr_lsb = 1.0 / 16.0;
   } else {
-    l.pr_lsb_ms = std::ldexp(1.0, -24);
-    l.ph_lsb_ms = std::ldexp(1.0, -29);
+    l.pr_lsb_ms = 1.0 / 16777216.0;   // 2^-24
+    l.ph_lsb_ms = 1.0 / 536870912.0;  // 2^-29
   }
   return l;
 }
@@ -105,13 +105,37 @@ std::string message_text(int number) {
 }
 
 /// Rounds x / lsb to an integer that fits a signed field of `bits` bits without its most negative value (the
-/// "invalid" marker); nullopt otherwise.
+/// "invalid" marker); nullopt otherwise. Rounds half away from zero, inline (std::round is a libm call).
 std::optional<std::int64_t> fit_signed(double x, double lsb, unsigned bits) {
-  const double q = std::round(x / lsb);
-  const double limit = std::ldexp(1.0, static_cast<int>(bits) - 1);
-  if (!(q > -limit && q < limit)) return std::nullopt;
-  return static_cast<std::int64_t>(q);
+  const double scaled = x / lsb;
+  const auto limit = static_cast<double>(std::int64_t{1} << (bits - 1));
+  if (!(scaled > -limit && scaled < limit)) return std::nullopt;
+  const auto q = static_cast<std::int64_t>(scaled + (scaled >= 0.0 ? 0.5 : -0.5));
+  if (q <= -static_cast<std::int64_t>(limit) || q >= static_cast<std::int64_t>(limit)) return std::nullopt;
+  return q;
 }
+
+/// RINEX code -> MSM signal id per system, built at compile time from the tables above.
+constexpr std::size_t kCodeSlots = std::size_t{10} * 26;  // band digit x attribute letter
+
+constexpr std::size_t code_slot(char band, char attribute) {
+  return static_cast<std::size_t>(band - '0') * 26 + static_cast<std::size_t>(attribute - 'A');
+}
+
+struct SignalIdLookup {
+  std::array<std::array<std::uint8_t, kCodeSlots>, core::kNumConstellations> ids{};
+  constexpr SignalIdLookup() {
+    for (int c = 0; c < core::kNumConstellations; ++c) {
+      const SignalTable& table = signal_table(static_cast<Constellation>(c));
+      for (std::size_t i = 0; i < table.size(); ++i) {
+        const char* code = table[i];
+        if (code[0] == '\0') continue;
+        ids[static_cast<std::size_t>(c)][code_slot(code[0], code[1])] = static_cast<std::uint8_t>(i + 1);
+      }
+    }
+  }
+};
+constexpr SignalIdLookup kSignalIds{};
 
 std::int64_t invalid_marker(unsigned bits) {
   return -(std::int64_t{1} << (bits - 1));
@@ -168,34 +192,34 @@ std::optional<core::SignalCode> msm_signal_code(Constellation system, int signal
 }
 
 std::optional<int> msm_signal_id(Constellation system, core::SignalCode code) {
-  const SignalTable& table = signal_table(system);
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    if (table[i][0] == code.band && table[i][1] == code.attribute) return static_cast<int>(i) + 1;
-  }
-  return std::nullopt;
+  if (code.band < '0' || code.band > '9' || code.attribute < 'A' || code.attribute > 'Z') return std::nullopt;
+  const int id = kSignalIds.ids[static_cast<std::size_t>(system)][code_slot(code.band, code.attribute)];
+  if (id == 0) return std::nullopt;
+  return id;
 }
 
 double msm_lock_time_ms(int indicator, bool extended) {
   if (!extended) {
     if (indicator <= 0) return 0.0;
-    return std::ldexp(1.0, std::min(indicator, 15) + 4);  // 1 -> 32 ms ... 15 -> 524288 ms
+    return static_cast<double>(std::int64_t{1} << (std::min(indicator, 15) + 4));  // 1 -> 32 ms ... 15 -> 524288 ms
   }
   if (indicator < 64) return std::max(indicator, 0);
   if (indicator >= 704) return 67108864.0;
   const int k = (indicator - 64) / 32 + 1;  // blocks of 32 indicators with a step of 2^k ms
-  return std::ldexp(1.0, k) * (indicator - 32 * k);
+  return static_cast<double>(static_cast<std::int64_t>(indicator - 32 * k) << k);
 }
 
 int msm_lock_indicator(double lock_time_ms, bool extended) {
   if (!(lock_time_ms > 0.0)) return 0;
   if (!extended) {
     if (lock_time_ms < 32.0) return 0;
-    const int i = static_cast<int>(std::floor(std::log2(lock_time_ms))) - 4;
-    return std::clamp(i, 1, 15);
+    if (lock_time_ms >= 524288.0) return 15;
+    const auto t = static_cast<std::uint64_t>(lock_time_ms);
+    return std::clamp(static_cast<int>(std::bit_width(t)) - 1 - 4, 1, 15);  // floor(log2(t)) - 4
   }
-  const auto t = static_cast<std::int64_t>(std::floor(lock_time_ms));
+  if (lock_time_ms >= 67108864.0) return 704;
+  const auto t = static_cast<std::int64_t>(lock_time_ms);
   if (t < 64) return static_cast<int>(t);
-  if (t >= 67108864) return 704;
   // Block k covers [64 * 2^(k-1), 64 * 2^k) with a step of 2^k.
   const int k = std::bit_width(static_cast<std::uint64_t>(t / 64));  // t / 64 in [2^(k-1), 2^k)
   return static_cast<int>(t >> k) + 32 * k;
@@ -288,7 +312,7 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
         }
       }
     }
-    const double rough_ms = std::round(rough_m / kRangeMsM / kRoughLsbMs) * kRoughLsbMs;
+    const double rough_ms = std::floor(rough_m / kRangeMsM / kRoughLsbMs + 0.5) * kRoughLsbMs;
     if (!(rough_ms > 0.0 && rough_ms < kInvalidRoughInt)) {
       ++report.dropped_satellites;
       continue;
@@ -296,7 +320,7 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
     plan.rough_ms = rough_ms;
     for (const MsmCell& c : s.cells) {
       if (core::has_value(c.phase_range_rate_mps)) {
-        plan.rough_rate_mps = std::round(c.phase_range_rate_mps);
+        plan.rough_rate_mps = std::floor(c.phase_range_rate_mps + 0.5);
         plan.rate_valid = std::abs(plan.rough_rate_mps) < 8192.0;
         break;
       }
@@ -360,8 +384,8 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
   }
 
   const std::size_t start = out.size();
-  out.reserve(start + (total_bits + 7) / 8);
-  BitWriter w(out);
+  out.resize(start + (total_bits + 7) / 8);
+  FixedBitWriter w(out.data() + start);
   w.u(static_cast<std::uint64_t>(number), 12);
   w.u(static_cast<std::uint64_t>(h.station_id & 0xFFF), 12);
   w.u(h.epoch_time & 0x3FFFFFFF, 30);
@@ -415,7 +439,7 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
   const double max_cnr = static_cast<double>((1U << l.cnr_bits) - 1);
   for (int i = 0; i < ncell; ++i) {
     const double cnr = cells[static_cast<std::size_t>(i)].cell->cnr_dbhz;
-    const double q = core::has_value(cnr) ? std::clamp(std::round(cnr / l.cnr_lsb), 1.0, max_cnr) : 0.0;
+    const double q = core::has_value(cnr) ? std::clamp(std::floor(cnr / l.cnr_lsb + 0.5), 1.0, max_cnr) : 0.0;
     w.u(static_cast<std::uint64_t>(q), l.cnr_bits);
   }
   if (l.extended) {
@@ -435,11 +459,18 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
       w.s(q, 15);
     }
   }
+  w.flush();
   report.cells = ncell;
   return report;
 }
 
 Result<MsmMessage> decode_msm(std::span<const std::uint8_t> payload) {
+  MsmMessage m;
+  if (Status s = decode_msm(payload, m); !s.ok()) return s.error();
+  return m;
+}
+
+Status decode_msm(std::span<const std::uint8_t> payload, MsmMessage& m) {
   const int number = message_number(payload);
   const auto kind = msm_kind(number);
   if (!kind) return Error{message_text(number) + " is not a Multiple Signal Message"};
@@ -451,8 +482,8 @@ Result<MsmMessage> decode_msm(std::span<const std::uint8_t> payload) {
   if (r.bits_left() < kMsmHeaderBits) {
     return Error{message_text(number) + ": " + std::to_string(payload.size()) + " bytes, shorter than an MSM header"};
   }
-  MsmMessage m;
   MsmHeader& h = m.header;
+  h = MsmHeader{};
   h.system = kind->system;
   h.type = kind->type;
   r.skip(12);
@@ -495,6 +526,10 @@ Result<MsmMessage> decode_msm(std::span<const std::uint8_t> payload) {
     }
   }
   m.satellites.resize(static_cast<std::size_t>(nsat));
+  for (MsmSatellite& s : m.satellites) {
+    s.extended_info = 15;
+    s.cells.clear();
+  }
   std::array<double, 64> rough_ms{};
   std::array<double, 64> rough_rate{};
   {
@@ -556,8 +591,9 @@ Result<MsmMessage> decode_msm(std::span<const std::uint8_t> payload) {
         v == ph_invalid ? core::kNoValue : (rough + static_cast<double>(v) * l.ph_lsb_ms) * kRangeMsM;
   }
   for (int i = 0; i < ncell; ++i) {
-    cell_ptr[static_cast<std::size_t>(i)]->lock_time_ms =
-        msm_lock_time_ms(static_cast<int>(r.u(l.lock_bits)), l.high_res);
+    const auto indicator = static_cast<int>(r.u(l.lock_bits));
+    cell_ptr[static_cast<std::size_t>(i)]->lock_indicator = indicator;
+    cell_ptr[static_cast<std::size_t>(i)]->lock_time_ms = msm_lock_time_ms(indicator, l.high_res);
   }
   for (int i = 0; i < ncell; ++i) cell_ptr[static_cast<std::size_t>(i)]->half_cycle = r.u(1) != 0;
   for (int i = 0; i < ncell; ++i) {
@@ -572,7 +608,7 @@ Result<MsmMessage> decode_msm(std::span<const std::uint8_t> payload) {
           v == kInvalidFineRate ? core::kNoValue : rough + static_cast<double>(v) * kFineRateLsbMps;
     }
   }
-  return m;
+  return Ok{};
 }
 
 }  // namespace canyon::io::rtcm3

@@ -111,6 +111,7 @@ Status append_antenna_info(const AntennaInfo& info, std::vector<std::uint8_t>& o
   if (Status s = append_string(w, info.receiver_type, "receiver type"); !s.ok()) return s;
   if (Status s = append_string(w, info.receiver_firmware, "receiver firmware"); !s.ok()) return s;
   if (Status s = append_string(w, info.receiver_serial, "receiver serial number"); !s.ok()) return s;
+  w.flush();
   out.insert(out.end(), payload.begin(), payload.end());
   return Ok{};
 }

@@ -455,6 +455,7 @@ Status UbxDecoder::add_sfrbx(const ubx::Sfrbx& s, Message& out) {
       std::vector<std::uint8_t> bits;
       BitWriter w(bits);
       for (const std::uint32_t word : s.words) w.u(word & 0x3FFFFFFF, 30);
+      w.flush();
       std::copy(bits.begin(), bits.end(), f.begin());
       auto r = beidou_.add(sat->prn, f, *reference);
       if (!r) {

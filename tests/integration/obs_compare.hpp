@@ -29,17 +29,17 @@ struct ObsComparison {
   int epochs_a = 0;
   int epochs_b = 0;
   int epochs_matched = 0;
-  std::map<char, int> values;          ///< compared values by kind C L D S
-  std::map<char, double> max_diff;     ///< largest |difference| (L: fractional part) by kind
+  std::map<char, int> values;            ///< compared values by kind C L D S
+  std::map<char, double> max_diff;       ///< largest |difference| (L: fractional part) by kind
   std::map<char, int> out_of_tolerance;  ///< values beyond the tolerance by kind
-  std::map<std::string, int> missing;  ///< "G 1Z C": values of a absent from b, by system, signal and kind
-  std::map<std::string, int> extra;    ///< values of b absent from a
-  int arc_offset_changes = 0;          ///< integer phase offset changed within an arc (no LLI in b)
-  int slips_lost = 0;                  ///< loss of lock in a, not in b
-  int slips_added = 0;                 ///< loss of lock in b, not in a, except at a signal's first epoch in b
-  int slips_added_first_epoch = 0;     ///< loss of lock in b at a signal's first epoch, not in a
-  int half_cycle_mismatches = 0;       ///< LLI bit 1 differs
-  std::vector<std::string> examples;   ///< the first differences, as text
+  std::map<std::string, int> missing;    ///< "G 1Z C": values of a absent from b, by system, signal and kind
+  std::map<std::string, int> extra;      ///< values of b absent from a
+  int arc_offset_changes = 0;            ///< integer phase offset changed within an arc (no LLI in b)
+  int slips_lost = 0;                    ///< loss of lock in a, not in b
+  int slips_added = 0;                   ///< loss of lock in b, not in a, except at a signal's first epoch in b
+  int slips_added_first_epoch = 0;       ///< loss of lock in b at a signal's first epoch, not in a
+  int half_cycle_mismatches = 0;         ///< LLI bit 1 differs
+  std::vector<std::string> examples;     ///< the first differences, as text
 
   [[nodiscard]] int total_out_of_tolerance() const {
     int n = 0;
@@ -183,9 +183,9 @@ inline ObsComparison compare_obs(const std::vector<core::ObsEpoch>& a, const std
 struct SlipWindows {
   int windows = 0;
   int agree = 0;
-  int lost = 0;                      ///< `a` flags the window, `b` does not
+  int lost = 0;                        ///< `a` flags the window, `b` does not
   int added_seen_in_extra_epochs = 0;  ///< `b` flags it where `a` does not, and `b` has epochs in it that `a` lacks
-  int added = 0;                     ///< `b` flags it where `a` does not, with the same epochs
+  int added = 0;                       ///< `b` flags it where `a` does not, with the same epochs
 };
 
 inline SlipWindows compare_slip_windows(const std::vector<core::ObsEpoch>& a, const std::vector<core::ObsEpoch>& b) {
@@ -198,7 +198,7 @@ inline SlipWindows compare_slip_windows(const std::vector<core::ObsEpoch>& a, co
         for (const auto& g : s.signals) {
           if (!core::has_value(g.carrier_phase_cyc)) continue;
           out[{s.sat.index(), g.code.band, g.code.attribute}].emplace_back(e.time.seconds_since_epoch(),
-                                                                            (g.lli & core::kLliLossOfLock) != 0);
+                                                                           (g.lli & core::kLliLossOfLock) != 0);
         }
       }
     }
@@ -240,7 +240,7 @@ struct NavComparison {
   int records_a = 0;
   int records_b = 0;
   int matched = 0;
-  int mismatched = 0;                ///< matched records with a parameter beyond tolerance
+  int mismatched = 0;  ///< matched records with a parameter beyond tolerance
   std::vector<std::string> examples;
 };
 
@@ -254,7 +254,8 @@ inline bool close(double x, double y, double relative, double absolute) {
 
 /// Relative tolerance 1e-11 (RINEX D19.12 prints 12 digits) on every orbit and clock parameter, toc and health;
 /// transmission times, accuracies and flags that RINEX writers fill differently are not compared.
-inline NavComparison compare_nav(const core::NavigationData& a, const core::NavigationData& b, double relative = 1e-11) {
+inline NavComparison compare_nav(const core::NavigationData& a, const core::NavigationData& b,
+                                 double relative = 1e-11) {
   NavComparison r;
   r.records_a = static_cast<int>(a.kepler.size() + a.glonass.size());
   r.records_b = static_cast<int>(b.kepler.size() + b.glonass.size());

@@ -28,12 +28,12 @@ using test::shared_data;
 
 const std::string kCanyon = CANYON_BINARY;
 
-#define SKIP_WITHOUT(path, what)                                                            \
-  if (!fs::exists(path)) {                                                                  \
-    GTEST_SKIP() << (what) << " not found at " << (path) << " (shared datasets absent)";    \
-  }                                                                                         \
-  if (test::run_command("command -v convbin && command -v str2str").exit_code != 0) {      \
-    GTEST_SKIP() << "RTKLIB (convbin, str2str) not installed: apt-get install rtklib";      \
+#define SKIP_WITHOUT(path, what)                                                         \
+  if (!fs::exists(path)) {                                                               \
+    GTEST_SKIP() << (what) << " not found at " << (path) << " (shared datasets absent)"; \
+  }                                                                                      \
+  if (test::run_command("command -v convbin && command -v str2str").exit_code != 0) {    \
+    GTEST_SKIP() << "RTKLIB (convbin, str2str) not installed: apt-get install rtklib";   \
   }
 
 std::string describe(const test::ObsComparison& c) {
@@ -90,13 +90,14 @@ TEST_P(RinexThroughConvbin, EqualsTheOriginalWithinMsmResolution) {
   SKIP_WITHOUT(obs, "observation file");
   const fs::path dir = test::temp_dir(std::string("rtcm_convbin_") + c.name + "_msm" + std::to_string(c.msm));
   const fs::path rtcm = dir / "stream.rtcm3";
-  const auto made = test::run_command(kCanyon + " convert " + obs.string() + " --nav " + (shared_data() / c.nav).string() +
-                                      " --out " + rtcm.string() + " --station-id 17 --msm " + std::to_string(c.msm));
+  const auto made =
+      test::run_command(kCanyon + " convert " + obs.string() + " --nav " + (shared_data() / c.nav).string() +
+                        " --out " + rtcm.string() + " --station-id 17 --msm " + std::to_string(c.msm));
   ASSERT_EQ(made.exit_code, 0) << made.output;
   std::cout << "[ canyon   ] " << made.output;
-  const auto decoded = test::run_command("convbin -r rtcm3 -tr \"" + std::string(c.approx_time) +
-                                         "\" -v 3.04 -od -os -o " + (dir / "rtklib.obs").string() + " -n " +
-                                         (dir / "rtklib.nav").string() + " " + rtcm.string());
+  const auto decoded =
+      test::run_command("convbin -r rtcm3 -tr \"" + std::string(c.approx_time) + "\" -v 3.04 -od -os -o " +
+                        (dir / "rtklib.obs").string() + " -n " + (dir / "rtklib.nav").string() + " " + rtcm.string());
   ASSERT_EQ(decoded.exit_code, 0) << decoded.output;
   const io::RinexObsFile original = read_obs(obs);
   const io::RinexObsFile back = read_obs(dir / "rtklib.obs");
@@ -150,21 +151,22 @@ TEST_P(RinexThroughConvbin, EqualsTheOriginalWithinMsmResolution) {
 
 INSTANTIATE_TEST_SUITE_P(
     Datasets, RinexThroughConvbin,
-    ::testing::Values(
-        RoundTripCase{"cssrlib_static_base", "cssrlib-static-doy078/3034078M1.21O", "cssrlib-static-doy078/SEPT078M.21P",
-                      "2021/03/19 12:00:00", 7},
-        RoundTripCase{"cssrlib_static_rover", "cssrlib-static-doy078/SEPT078M1.21O", "cssrlib-static-doy078/SEPT078M.21P",
-                      "2021/03/19 12:00:00", 7},
-        RoundTripCase{"matrtklib_base", "matrtklib-static/base.obs", "matrtklib-static/base.nav", "2024/06/24 08:20:00", 7},
-        RoundTripCase{"matrtklib_rover", "matrtklib-static/rover.obs", "matrtklib-static/base.nav", "2024/06/24 08:20:00",
-                      7},
-        RoundTripCase{"cssrlib_kinematic_base", "cssrlib-kinematic-doy265/3034265G.21O",
-                      "cssrlib-kinematic-doy265/SEPT2650.21P", "2021/09/22 06:30:00", 7},
-        RoundTripCase{"cssrlib_kinematic_rover", "cssrlib-kinematic-doy265/SEPT265G.21O",
-                      "cssrlib-kinematic-doy265/SEPT2650.21P", "2021/09/22 06:30:00", 7},
-        RoundTripCase{"matrtklib_base", "matrtklib-static/base.obs", "matrtklib-static/base.nav", "2024/06/24 08:20:00", 4},
-        RoundTripCase{"cssrlib_static_base", "cssrlib-static-doy078/3034078M1.21O", "cssrlib-static-doy078/SEPT078M.21P",
-                      "2021/03/19 12:00:00", 4}),
+    ::testing::Values(RoundTripCase{"cssrlib_static_base", "cssrlib-static-doy078/3034078M1.21O",
+                                    "cssrlib-static-doy078/SEPT078M.21P", "2021/03/19 12:00:00", 7},
+                      RoundTripCase{"cssrlib_static_rover", "cssrlib-static-doy078/SEPT078M1.21O",
+                                    "cssrlib-static-doy078/SEPT078M.21P", "2021/03/19 12:00:00", 7},
+                      RoundTripCase{"matrtklib_base", "matrtklib-static/base.obs", "matrtklib-static/base.nav",
+                                    "2024/06/24 08:20:00", 7},
+                      RoundTripCase{"matrtklib_rover", "matrtklib-static/rover.obs", "matrtklib-static/base.nav",
+                                    "2024/06/24 08:20:00", 7},
+                      RoundTripCase{"cssrlib_kinematic_base", "cssrlib-kinematic-doy265/3034265G.21O",
+                                    "cssrlib-kinematic-doy265/SEPT2650.21P", "2021/09/22 06:30:00", 7},
+                      RoundTripCase{"cssrlib_kinematic_rover", "cssrlib-kinematic-doy265/SEPT265G.21O",
+                                    "cssrlib-kinematic-doy265/SEPT2650.21P", "2021/09/22 06:30:00", 7},
+                      RoundTripCase{"matrtklib_base", "matrtklib-static/base.obs", "matrtklib-static/base.nav",
+                                    "2024/06/24 08:20:00", 4},
+                      RoundTripCase{"cssrlib_static_base", "cssrlib-static-doy078/3034078M1.21O",
+                                    "cssrlib-static-doy078/SEPT078M.21P", "2021/03/19 12:00:00", 4}),
     [](const ::testing::TestParamInfo<RoundTripCase>& info) {
       return std::string(info.param.name) + "_msm" + std::to_string(info.param.msm);
     });
@@ -279,13 +281,12 @@ fs::path str2str_rtcm(const fs::path& ubx_gz, const fs::path& dir) {
   auto bytes = io::read_binary_file(ubx_gz.string());
   EXPECT_TRUE(bytes.ok());
   const fs::path ubx = dir / "log.ubx";
-  std::ofstream(ubx, std::ios::binary).write(reinterpret_cast<const char*>(bytes->data()),
-                                             static_cast<std::streamsize>(bytes->size()));
+  std::ofstream(ubx, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()));
   fs::path out = dir / "str2str.rtcm3";
   const fs::path log = dir / "str2str.log";
   // str2str does not exit at the end of a file: stop it once it reports the input ended.
-  const std::string command = "bash -c 'str2str -in \"file://" + ubx.string() + "#ubx\" -out \"file://" +
-                              out.string() +
+  const std::string command = "bash -c 'str2str -in \"file://" + ubx.string() + "#ubx\" -out \"file://" + out.string() +
                               "#rtcm3\" -msg \"1077,1087,1117,1005(10),1019,1020,1044\" -p 53.2804778 -9.0578437 79.05 "
                               "2> " +
                               log.string() + " & pid=$!; for i in $(seq 1 600); do grep -q \" end\" " + log.string() +
@@ -303,9 +304,9 @@ TEST(Str2strRtklib, UbxLogThroughStr2strDecodesLikeConvbin) {
   ASSERT_GT(fs::file_size(rtcm), 100000U);
   // RTKLIB's own conversion of the stream, and canyon's (through the command, which dates the stream from its GPS
   // ephemerides: no --time).
-  const auto rtk = test::run_command("convbin -r rtcm3 -tr \"2018/10/04 15:30:00\" -v 3.04 -od -os -o " +
-                                     (tmp / "rtklib.obs").string() + " -n " + (tmp / "rtklib.nav").string() + " " +
-                                     rtcm.string());
+  const auto rtk =
+      test::run_command("convbin -r rtcm3 -tr \"2018/10/04 15:30:00\" -v 3.04 -od -os -o " +
+                        (tmp / "rtklib.obs").string() + " -n " + (tmp / "rtklib.nav").string() + " " + rtcm.string());
   ASSERT_EQ(rtk.exit_code, 0) << rtk.output;
   const auto can = test::run_command(kCanyon + " convert " + rtcm.string() + " --obs-out " +
                                      (tmp / "canyon.obs").string() + " --nav-out " + (tmp / "canyon.nav").string());
@@ -377,15 +378,15 @@ TEST(UbxRtklib, BaseReceiversOwnRtcmDecodesLikeConvbin) {
   auto bytes = io::read_binary_file((dir / kBase.ubx).string());
   ASSERT_TRUE(bytes.ok());
   const fs::path log = tmp / "base.ubx";
-  std::ofstream(log, std::ios::binary).write(reinterpret_cast<const char*>(bytes->data()),
-                                             static_cast<std::streamsize>(bytes->size()));
-  const auto rtk = test::run_command("convbin -r rtcm3 -tr \"2018/10/04 15:00:00\" -v 3.04 -od -os -o " +
-                                     (tmp / "rtklib.obs").string() + " -n " + (tmp / "rtklib.nav").string() + " " +
-                                     log.string());
+  std::ofstream(log, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()));
+  const auto rtk =
+      test::run_command("convbin -r rtcm3 -tr \"2018/10/04 15:00:00\" -v 3.04 -od -os -o " +
+                        (tmp / "rtklib.obs").string() + " -n " + (tmp / "rtklib.nav").string() + " " + log.string());
   ASSERT_EQ(rtk.exit_code, 0) << rtk.output;
-  const auto can = test::run_command(kCanyon + " convert " + log.string() + " --from rtcm3 --time \"2018-10-04 15:00:00\" " +
-                                     "--obs-out " + (tmp / "canyon.obs").string() + " --nav-out " +
-                                     (tmp / "canyon.nav").string());
+  const auto can =
+      test::run_command(kCanyon + " convert " + log.string() + " --from rtcm3 --time \"2018-10-04 15:00:00\" " +
+                        "--obs-out " + (tmp / "canyon.obs").string() + " --nav-out " + (tmp / "canyon.nav").string());
   ASSERT_EQ(can.exit_code, 0) << can.output;
   std::cout << "[ canyon   ] " << can.output;
   const io::RinexObsFile rtklib = read_obs(tmp / "rtklib.obs");

@@ -84,6 +84,7 @@ TEST(Bits, RandomFieldsRoundTrip) {
       }
       fields.push_back({n, v, kind});
     }
+    w.flush();
     BitReader r(buffer);
     for (const Field& f : fields) {
       const std::int64_t got = f.kind == 0 ? static_cast<std::int64_t>(r.u(f.n)) : (f.kind == 1 ? r.s(f.n) : r.sm(f.n));

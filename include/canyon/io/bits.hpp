@@ -92,23 +92,30 @@ class BitReader {
   std::size_t pos_;
 };
 
-/// Sequential writer: appends fields to a byte vector (the last byte is zero-padded).
+/// Sequential writer: appends fields to a byte vector (the last byte is zero-padded). Bits collect in a 64-bit
+/// accumulator and go to the vector a byte at a time; the vector holds every completed byte, and the partial last
+/// byte once flush() or the destructor ran (bits() and position() count all bits at any time).
 class BitWriter {
  public:
   explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out), start_bits_(8 * out.size()) {}
+  ~BitWriter() { flush(); }
+  BitWriter(const BitWriter&) = delete;
+  BitWriter& operator=(const BitWriter&) = delete;
 
   /// Appends the low `n` bits of `value` (n <= 64).
   void u(std::uint64_t value, unsigned n) {
     assert(n <= 64);
-    while (n > 0) {
-      const unsigned used = static_cast<unsigned>(bits_ & 7);
-      if (used == 0) out_.push_back(0);
-      const unsigned room = 8 - used;
-      const unsigned take = n < room ? n : room;
-      const auto chunk = static_cast<std::uint8_t>((value >> (n - take)) & ((1U << take) - 1));
-      out_.back() = static_cast<std::uint8_t>(out_.back() | (chunk << (room - take)));
-      n -= take;
-      bits_ += take;
+    if (n > 32) {
+      u(value >> 32, n - 32);
+      n = 32;
+    }
+    value &= n == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n) - 1;
+    acc_ = (acc_ << n) | value;  // acc_ holds fewer than 8 pending bits, so n <= 32 always fits
+    pending_ += n;
+    bits_ += n;
+    while (pending_ >= 8) {
+      pending_ -= 8;
+      out_.push_back(static_cast<std::uint8_t>(acc_ >> pending_));
     }
   }
   /// Two's complement; the caller checks the range.
@@ -117,6 +124,14 @@ class BitWriter {
   void sm(std::int64_t value, unsigned n) {
     const std::uint64_t magnitude = static_cast<std::uint64_t>(value < 0 ? -value : value);
     u(((value < 0 ? std::uint64_t{1} : 0) << (n - 1)) | magnitude, n);
+  }
+  /// Writes the partial last byte (zero-padded) into the vector; further writes start a new byte.
+  void flush() {
+    if (pending_ > 0) {
+      out_.push_back(static_cast<std::uint8_t>(acc_ << (8 - pending_)));
+      bits_ += 8 - pending_;
+      pending_ = 0;
+    }
   }
   /// Bits written by this writer.
   [[nodiscard]] std::size_t bits() const { return bits_; }
@@ -127,6 +142,49 @@ class BitWriter {
   std::vector<std::uint8_t>& out_;
   std::size_t start_bits_;
   std::size_t bits_ = 0;
+  std::uint64_t acc_ = 0;
+  unsigned pending_ = 0;  // bits in acc_ not yet in out_ (< 8)
+};
+
+/// Writer into a buffer the caller has sized to hold every bit it will write (hot paths: MSM encoding). Whole
+/// 32-bit words are stored as they fill; flush() stores the rest, the last byte zero-padded.
+class FixedBitWriter {
+ public:
+  explicit FixedBitWriter(std::uint8_t* data) : p_(data) {}
+
+  void u(std::uint64_t value, unsigned n) {
+    assert(n <= 64);
+    if (n > 32) {
+      u(value >> 32, n - 32);
+      n = 32;
+    }
+    value &= (std::uint64_t{1} << n) - 1;
+    acc_ = (acc_ << n) | value;  // fewer than 32 pending bits + at most 32 new ones
+    pending_ += n;
+    if (pending_ >= 32) {
+      pending_ -= 32;
+      const auto word = static_cast<std::uint32_t>(acc_ >> pending_);
+      p_[0] = static_cast<std::uint8_t>(word >> 24);
+      p_[1] = static_cast<std::uint8_t>(word >> 16);
+      p_[2] = static_cast<std::uint8_t>(word >> 8);
+      p_[3] = static_cast<std::uint8_t>(word);
+      p_ += 4;
+    }
+  }
+  void s(std::int64_t value, unsigned n) { u(static_cast<std::uint64_t>(value), n); }
+  void flush() {
+    while (pending_ >= 8) {
+      pending_ -= 8;
+      *p_++ = static_cast<std::uint8_t>(acc_ >> pending_);
+    }
+    if (pending_ > 0) *p_++ = static_cast<std::uint8_t>(acc_ << (8 - pending_));
+    pending_ = 0;
+  }
+
+ private:
+  std::uint8_t* p_;
+  std::uint64_t acc_ = 0;
+  unsigned pending_ = 0;
 };
 
 }  // namespace canyon::io

@@ -73,6 +73,7 @@ struct MsmCell {
   double phase_range_rate_mps = core::kNoValue;  ///< MSM5/7 only (m/s); Doppler = -rate / wavelength
   double cnr_dbhz = core::kNoValue;              ///< carrier-to-noise ratio (dB-Hz)
   double lock_time_ms = 0.0;                     ///< minimum lock time the indicator guarantees (ms)
+  int lock_indicator = 0;                        ///< decoding: DF402 / DF407 as sent (encoding uses lock_time_ms)
   bool half_cycle = false;                       ///< DF420: half-cycle ambiguity not resolved
 };
 
@@ -112,8 +113,10 @@ struct MsmEncodeReport {
 /// Appends the payload of one MSM (header.type 4-7) to `out`. At most 64 cells: the caller splits larger sets (see
 /// Rtcm3Encoder). Error if the message would exceed 64 cells or 1023 bytes.
 Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::uint8_t>& out);
-/// Decodes an MSM payload (types 1-7; 1-3 give cells without values).
+/// Decodes an MSM payload (types 4-7; 1-3 carry no complete observables and are refused).
 Result<MsmMessage> decode_msm(std::span<const std::uint8_t> payload);
+/// The same into `out`, reusing its storage (no allocation once it has held a message as large).
+Status decode_msm(std::span<const std::uint8_t> payload, MsmMessage& out);
 
 /// Lock time indicators: MSM4/5 DF402 (4 bits) and MSM6/7 DF407 (10 bits), as minimum lock times in ms.
 [[nodiscard]] double msm_lock_time_ms(int indicator, bool extended);

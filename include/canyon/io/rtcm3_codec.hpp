@@ -30,6 +30,7 @@
 //  - Signals RTCM cannot name (e.g. QZSS L1 SAIF "1Z"), satellites without any pseudorange, and values outside
 //    their fields are dropped and counted in the report.
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -45,6 +46,7 @@
 #include "canyon/core/result.hpp"
 #include "canyon/core/time.hpp"
 #include "canyon/io/rtcm3.hpp"
+#include "canyon/io/signal_table.hpp"
 
 namespace canyon::io {
 
@@ -103,8 +105,6 @@ class Rtcm3Decoder {
     double last_phase_cyc = core::kNoValue;  // legacy messages: continuity of the phase-range field
     bool seen = false;
   };
-  using SignalKey = std::tuple<int, char, char>;  // satellite index, band, attribute
-
   Status add_msm(const rtcm3::MsmMessage& msm, Message& out);
   Status add_legacy(const rtcm3::LegacyObsMessage& legacy, Message& out);
   /// Starts a new epoch at `time` if it differs from the one being assembled.
@@ -121,9 +121,11 @@ class Rtcm3Decoder {
   core::GpsTime reference_;
   std::optional<core::GpsTime> last_epoch_time_;
   std::optional<core::ObsEpoch> assembling_;
+  std::array<int, core::kMaxSatellites> slot_of_{};  // satellite index -> position in assembling_->sats, or -1
   std::vector<core::ObsEpoch> ready_;
   std::size_t ready_head_ = 0;
-  std::map<SignalKey, LockState> locks_;
+  SignalTable<LockState> locks_;
+  rtcm3::MsmMessage msm_;               // decoded into, reused
   std::map<int, int> glonass_channel_;  // slot -> channel
   std::optional<rtcm3::StationPosition> station_;
   std::optional<rtcm3::AntennaInfo> antenna_;
@@ -190,12 +192,11 @@ class Rtcm3Encoder {
     core::GpsTime start;      // lock start
     bool valid = false;
   };
-  using SignalKey = std::tuple<int, char, char>;
-
   Rtcm3EncoderOptions options_;
   std::map<int, int> glonass_channel_;
-  std::map<SignalKey, Arc> arcs_;
-  std::vector<std::uint8_t> payload_;  // scratch
+  SignalTable<Arc> arcs_;
+  std::array<std::vector<rtcm3::MsmSatellite>, core::kNumConstellations> per_system_;  // scratch
+  std::vector<std::uint8_t> payload_;                                                  // scratch
 };
 
 }  // namespace canyon::io
