@@ -10,18 +10,22 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <mutex>
+#include <thread>
 
 #include "canyon/io/gnss_stream.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
 #include "canyon/io/rtcm3_station_stream.hpp"
+#include "canyon/net/socket.hpp"
+#include "canyon/net/stream_client.hpp"
 
 namespace canyon::app {
 namespace {
 
 /// `input` without a .gz suffix and its extension, plus `extension`.
 std::string sibling(const std::string& input, const std::string& extension) {
-  std::filesystem::path p(input == "-" ? "stdin" : input);
+  std::filesystem::path p(input == "-" || input.find("://") != std::string::npos ? "stream" : input);
   if (p.extension() == ".gz") p.replace_extension();
   p.replace_extension(extension);
   return p.string();
@@ -36,7 +40,57 @@ core::GpsTime now_gps() {
   return core::utc_to_gps(c, core::builtin_leap_seconds());
 }
 
-Result<std::vector<std::uint8_t>> read_input(const std::string& path, std::vector<std::string>& warnings) {
+Result<std::vector<std::uint8_t>> record_stream(const ConvertConfig& config, const StreamUrl& url,
+                                                std::vector<std::string>& warnings) {
+  net::StreamClientOptions o;
+  o.mode = url.ntrip ? net::StreamClientOptions::Mode::Ntrip : net::StreamClientOptions::Mode::Tcp;
+  o.host = url.host;
+  o.port = url.port;
+  o.mount = url.mount;
+  o.user = url.user;
+  o.password = url.password;
+  o.ntrip_version = config.ntrip_version;
+  o.max_attempts = 3;
+  o.backoff_min_s = 0.5;
+  o.stall_timeout_s = std::max(config.idle_timeout_s, 1.0);
+  std::mutex mutex;
+  std::vector<std::uint8_t> bytes;
+  auto last = std::chrono::steady_clock::now();
+  net::StreamClient client(
+      o,
+      [&](std::span<const std::uint8_t> data) {
+        const std::lock_guard lock(mutex);
+        bytes.insert(bytes.end(), data.begin(), data.end());
+        last = std::chrono::steady_clock::now();
+      },
+      [&](const std::string& e) {
+        const std::lock_guard lock(mutex);
+        warnings.push_back(config.input + ": " + e);
+      });
+  if (Status s = client.start(); !s.ok()) return s.error();
+  const auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto now = std::chrono::steady_clock::now();
+    const std::lock_guard lock(mutex);
+    if (config.duration_s > 0.0 && now - start >= std::chrono::duration<double>(config.duration_s)) break;
+    if (!bytes.empty() && now - last >= std::chrono::duration<double>(config.idle_timeout_s)) break;
+    if (client.finished()) break;
+  }
+  client.stop();
+  const std::lock_guard lock(mutex);
+  if (bytes.empty()) {
+    return Error{"no data received" + (warnings.empty() ? std::string() : " (" + warnings.back() + ")"), config.input,
+                 0};
+  }
+  return bytes;
+}
+
+Result<std::vector<std::uint8_t>> read_input(const ConvertConfig& config, std::vector<std::string>& warnings) {
+  auto url = parse_stream_url(config.input);
+  if (!url) return url.error();
+  if (*url) return record_stream(config, **url, warnings);
+  const std::string& path = config.input;
   if (path == "-") {
     std::vector<std::uint8_t> bytes;
     char buffer[1 << 16];
@@ -263,12 +317,48 @@ std::string ConvertConfig::validate() const {
   if (from != "auto" && from != "rtcm3" && from != "ubx" && from != "rinex") {
     return "--from must be auto, rtcm3, ubx or rinex, not '" + from + "'";
   }
-  if (from == "rinex" && input == "-") return "RINEX input must be a file";
+  if (from == "rinex" && (input == "-" || input.find("://") != std::string::npos)) return "RINEX input must be a file";
+  if (!(duration_s >= 0.0)) return "duration must be >= 0 s";
+  if (!(idle_timeout_s > 0.0)) return "idle timeout must be > 0 s";
+  if (ntrip_version != 1 && ntrip_version != 2) return "NTRIP version must be 1 or 2";
   if (station_id < 0 || station_id > 4095) return "station id must be within 0-4095";
   if (msm < 4 || msm > 7) return "MSM type must be 4, 5, 6 or 7";
   if (!(station_interval_s >= 0.0)) return "station interval must be >= 0 s";
   if (!(ephemeris_interval_s >= 0.0)) return "ephemeris interval must be >= 0 s";
   return {};
+}
+
+Result<std::optional<StreamUrl>> parse_stream_url(const std::string& text) {
+  StreamUrl u;
+  std::string rest;
+  if (text.rfind("ntrip://", 0) == 0) {
+    u.ntrip = true;
+    rest = text.substr(8);
+  } else if (text.rfind("tcp://", 0) == 0) {
+    rest = text.substr(6);
+  } else {
+    return std::optional<StreamUrl>{};
+  }
+  const std::string usage = "'" + text + "' is not tcp://HOST:PORT or ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT";
+  if (u.ntrip) {
+    const std::size_t slash = rest.find('/');
+    if (slash == std::string::npos || slash + 1 >= rest.size()) return Error{usage};
+    u.mount = rest.substr(slash + 1);
+    rest = rest.substr(0, slash);
+    const std::size_t at = rest.rfind('@');
+    if (at != std::string::npos) {
+      const std::string credentials = rest.substr(0, at);
+      rest = rest.substr(at + 1);
+      const std::size_t colon = credentials.find(':');
+      u.user = credentials.substr(0, colon);
+      if (colon != std::string::npos) u.password = credentials.substr(colon + 1);
+    }
+  }
+  auto endpoint = net::parse_endpoint(rest);
+  if (!endpoint || rest.front() == ':') return Error{usage};
+  u.host = endpoint->host;
+  u.port = endpoint->port;
+  return std::optional<StreamUrl>{u};
 }
 
 std::optional<core::GpsTime> parse_gps_calendar(const std::string& text) {
@@ -293,7 +383,7 @@ Result<ConvertSummary> run_convert(const ConvertConfig& config) {
   if (const std::string e = config.validate(); !e.empty()) return Error{e};
   std::vector<std::string> warnings;
   if (config.from == "rinex") return rinex_to_rtcm(config, warnings);
-  auto bytes = read_input(config.input, warnings);
+  auto bytes = read_input(config, warnings);
   if (!bytes) return bytes.error();
   if (config.from == "auto" && looks_like_rinex(*bytes)) return rinex_to_rtcm(config, warnings);
   const auto format = io::parse_stream_format(config.from);

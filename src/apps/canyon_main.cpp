@@ -1,8 +1,10 @@
 // The `canyon` command: subcommands for canyon's jobs. Exit codes: 0 success, 1 bad input or failed run,
 // 2 bad command line or configuration.
 
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <string>
 
@@ -375,7 +377,9 @@ void add_convert_command(CLI::App& app, ConvertArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "convert", "RTCM 3 or u-blox UBX (file or stdin) -> RINEX 3 observations and navigation; RINEX -> RTCM 3");
   canyon::app::ConvertConfig& c = args.config;
-  cmd->add_option("input", c.input, "Input: RTCM 3 / UBX stream file (may be .gz; '-' reads stdin) or RINEX obs")
+  cmd->add_option("input", c.input,
+                  "Input: RTCM 3 / UBX stream file (may be .gz; '-' reads stdin; tcp://HOST:PORT or "
+                  "ntrip://[USER[:PASS]@]HOST:PORT/MOUNT records a live stream) or RINEX observations")
       ->required();
   cmd->add_option("--from", c.from, "Input format: auto (default), rtcm3, ubx or rinex")
       ->check(CLI::IsMember({"auto", "rtcm3", "ubx", "rinex"}));
@@ -385,6 +389,13 @@ void add_convert_command(CLI::App& app, ConvertArgs& args) {
                   "Approximate GPST of the data, 'YYYY-MM-DD HH:MM:SS' (RTCM 3 weeks; default: from an ephemeris in "
                   "the stream, else the current date)");
   cmd->add_option("--marker", c.marker, "RINEX marker name");
+  cmd->add_option("--duration", c.duration_s, "Network input: record this many seconds (default: until idle)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--idle-timeout", c.idle_timeout_s,
+                  "Network input: stop when no byte came for this many seconds (default 5)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--ntrip-version", c.ntrip_version, "Network input: NTRIP request version, 1 or 2 (default 2)")
+      ->check(CLI::IsMember({1, 2}));
   cmd->add_option("--out", c.rtcm_out, "RTCM 3 output of a RINEX input (default: INPUT.rtcm3)");
   cmd->add_option("--nav", c.nav, "RINEX navigation file whose ephemerides go into the RTCM 3 stream (repeat)");
   cmd->add_option("--station-id", c.station_id, "RTCM 3 reference station id, 0-4095 (default 0)")
@@ -477,7 +488,33 @@ int run_main(int argc, char** argv) {
 
 }  // namespace
 
+/// `canyon base ...` runs `canyon-base ...` (the DDS executable next to this one) with the same arguments.
+int exec_dds_command(const std::string& command, int argc, char** argv) {
+  char self[4096];
+  const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+  std::string dir = ".";
+  if (n > 0) {
+    self[n] = '\0';
+    dir = self;
+    dir = dir.substr(0, dir.find_last_of('/'));
+  }
+  const std::string program = dir + "/canyon-" + command;
+  if (access(program.c_str(), X_OK) != 0) {
+    std::cerr << "canyon: error: '" << command << "' runs " << program
+              << ", which is missing (build it: cmake --build build --target canyon-" << command << ")\n";
+    return kExitUsage;
+  }
+  std::vector<char*> args;
+  args.push_back(const_cast<char*>(program.c_str()));
+  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  execv(program.c_str(), args.data());
+  std::cerr << "canyon: error: cannot run " << program << ": " << std::strerror(errno) << "\n";
+  return kExitInput;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "base") return exec_dds_command("base", argc, argv);
   // Bad input is reported through Result; an exception here is a bug or resource exhaustion: say so and fail.
   try {
     return run_main(argc, argv);

@@ -203,7 +203,8 @@ Result<NtripRequest> parse_ntrip_request(std::string_view header) {
   } else {
     return Error{"unsupported method '" + r.method + "'"};
   }
-  if (path.empty() || path.front() != '/') return Error{"request path '" + std::string(path) + "' does not start with /"};
+  if (path.empty() || path.front() != '/')
+    return Error{"request path '" + std::string(path) + "' does not start with /"};
   path.remove_prefix(1);
   path = path.substr(0, path.find('?'));
   r.mount = std::string(path);

@@ -2,11 +2,12 @@
 
 #include "canyon/net/socket.hpp"
 
-#include <arpa/inet.h>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstring>
+
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -136,7 +137,8 @@ Result<Fd> tcp_connect(const std::string& host, int port, int timeout_ms) {
   if (rc != 0) {
     pollfd p{fd.get(), POLLOUT, 0};
     const int ready = ::poll(&p, 1, timeout_ms);
-    if (ready == 0) return Error{"cannot connect to " + where + ": timed out after " + std::to_string(timeout_ms) + " ms"};
+    if (ready == 0)
+      return Error{"cannot connect to " + where + ": timed out after " + std::to_string(timeout_ms) + " ms"};
     int error = 0;
     socklen_t len = sizeof error;
     ::getsockopt(fd.get(), SOL_SOCKET, SO_ERROR, &error, &len);
@@ -160,7 +162,8 @@ Status send_all(const Fd& fd, std::span<const std::uint8_t> data, int timeout_ms
       continue;
     }
     if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) return Error{system_error("send")};
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) return Error{"send: timed out"};
     pollfd p{fd.get(), POLLOUT, 0};
     ::poll(&p, 1, static_cast<int>(left.count()));

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+
 #include <poll.h>
 #include <sys/socket.h>
 
@@ -30,6 +31,12 @@ Result<std::pair<std::string, std::string>> read_header(const Fd& fd, int timeou
   char buffer[2048];
   for (;;) {
     if (const auto end = header_end(data)) return std::make_pair(data.substr(0, *end), data.substr(*end));
+    // NTRIP 1 casters (RTKLIB's str2str among them) may send "ICY 200 OK" and a single line end before the data.
+    constexpr std::string_view kIcy = "ICY 200 OK\r\n";
+    if (data.size() >= kIcy.size() + 2 && data.compare(0, kIcy.size(), kIcy) == 0) {
+      const std::size_t skip = data.compare(kIcy.size(), 2, "\r\n") == 0 ? kIcy.size() + 2 : kIcy.size();
+      return std::make_pair(std::string(kIcy) + "\r\n", data.substr(skip));
+    }
     if (data.size() > kMaxHeaderBytes) return Error{"response header longer than " + std::to_string(kMaxHeaderBytes)};
     if (running != nullptr && !running->load()) return Error{"stopped"};
     if (seconds_since(start) * 1000.0 > timeout_ms) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -24,10 +25,10 @@ struct StreamServer::Client {
   Fd fd;
   std::string peer;
   State state = State::Handshake;
-  std::string in;        // handshake header, then upstream line
+  std::string in;  // handshake header, then upstream line
   std::string mount;
   int version = 1;
-  std::string out;       // pending output
+  std::string out;  // pending output
   std::size_t out_pos = 0;
   bool close_after_flush = false;
   bool closed = false;
@@ -89,6 +90,9 @@ StreamServerStats StreamServer::stats() const {
   s.clients = static_cast<int>(std::count_if(clients_.begin(), clients_.end(), [](const auto& c) {
     return c->state == Client::State::Streaming && !c->closed;
   }));
+  for (const auto& c : clients_) {
+    if (!c->closed) s.pending_bytes += c->out.size() - c->out_pos;
+  }
   return s;
 }
 
@@ -101,8 +105,7 @@ void StreamServer::publish(const std::string& mount, std::span<const std::uint8_
       if (options_.mode == StreamServerOptions::Mode::Ntrip && c->mount != mount) continue;
       if (c->out.size() - c->out_pos + bytes.size() > options_.max_client_buffer_bytes) {
         ++stats_.dropped_slow;
-        event(c->peer + " disconnected: too slow (" + std::to_string(c->out.size() - c->out_pos) +
-              " bytes not sent)");
+        event(c->peer + " disconnected: too slow (" + std::to_string(c->out.size() - c->out_pos) + " bytes not sent)");
         c->closed = true;
         continue;
       }
@@ -188,8 +191,8 @@ void StreamServer::handshake(Client& c) {
     refuse(version, 404, "Not Found", "unknown mount point /" + request->mount);
     return;
   }
-  if (!options_.user.empty() && (request->user.value_or("") != options_.user ||
-                                 request->password.value_or("") != options_.password)) {
+  if (!options_.user.empty() &&
+      (request->user.value_or("") != options_.user || request->password.value_or("") != options_.password)) {
     refuse(version, 401, "Unauthorized", "wrong or missing credentials for /" + request->mount);
     return;
   }

@@ -1,13 +1,13 @@
 // NTRIP protocol text: requests and responses of versions 1 and 2, Basic authentication, the source table, chunked
 // transfer coding; malformed input gives an error naming the problem.
 
+#include "canyon/net/ntrip.hpp"
+
 #include <random>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
-
-#include "canyon/net/ntrip.hpp"
 
 namespace canyon::net {
 namespace {
@@ -57,8 +57,9 @@ TEST(Ntrip, RequestsOfBothVersionsRoundTrip) {
     }
   }
   // RTKLIB 2.4.3's NTRIP 1 request.
-  auto rtklib = parse_ntrip_request("GET /BASE HTTP/1.0\r\nUser-Agent: NTRIP RTKLIB/2.4.3\r\nAccept: */*\r\n"
-                                    "Connection: close\r\n\r\n");
+  auto rtklib = parse_ntrip_request(
+      "GET /BASE HTTP/1.0\r\nUser-Agent: NTRIP RTKLIB/2.4.3\r\nAccept: */*\r\n"
+      "Connection: close\r\n\r\n");
   ASSERT_TRUE(rtklib.ok());
   EXPECT_EQ(rtklib->version, 1);
   EXPECT_EQ(rtklib->mount, "BASE");
@@ -66,11 +67,11 @@ TEST(Ntrip, RequestsOfBothVersionsRoundTrip) {
 }
 
 TEST(Ntrip, MalformedRequestsAreErrors) {
-  for (const std::string& bad : std::vector<std::string>{"", "\r\n\r\n", "GET\r\n\r\n", "GET BASE HTTP/1.0\r\n\r\n", "DELETE /X HTTP/1.1\r\n\r\n",
-                                "GET /X HTTP/1.1\r\nAuthorization: Digest abc\r\n\r\n",
-                                "GET /X HTTP/1.1\r\nAuthorization: Basic !!!\r\n\r\n",
-                                "GET /X HTTP/1.1\r\nno colon here\r\n\r\n", "GET /X SMTP\r\n\r\n",
-                                std::string("GET /X HTTP/1.0\r\nUser-Agent: a\x01\r\n\r\n")}) {
+  for (const std::string& bad : std::vector<std::string>{
+           "", "\r\n\r\n", "GET\r\n\r\n", "GET BASE HTTP/1.0\r\n\r\n", "DELETE /X HTTP/1.1\r\n\r\n",
+           "GET /X HTTP/1.1\r\nAuthorization: Digest abc\r\n\r\n",
+           "GET /X HTTP/1.1\r\nAuthorization: Basic !!!\r\n\r\n", "GET /X HTTP/1.1\r\nno colon here\r\n\r\n",
+           "GET /X SMTP\r\n\r\n", std::string("GET /X HTTP/1.0\r\nUser-Agent: a\x01\r\n\r\n")}) {
     auto r = parse_ntrip_request(bad);
     EXPECT_FALSE(r.ok()) << "accepted: " << bad;
   }
@@ -160,7 +161,8 @@ TEST(Ntrip, ChunkedDecodingInAnySplit) {
 }
 
 TEST(Ntrip, MalformedChunksAreErrors) {
-  for (const std::string& bad : std::vector<std::string>{"zz\r\nabc\r\n", "3\r\nabcX", std::string(300, '1') + "\r\n", "FFFFFFFFF\r\n"}) {
+  for (const std::string& bad :
+       std::vector<std::string>{"zz\r\nabc\r\n", "3\r\nabcX", std::string(300, '1') + "\r\n", "FFFFFFFFF\r\n"}) {
     ChunkedDecoder d;
     std::vector<std::uint8_t> out;
     EXPECT_FALSE(d.feed(bytes(bad), out).ok()) << bad.substr(0, 20);

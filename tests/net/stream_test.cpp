@@ -64,7 +64,8 @@ bool wait_for(Pred pred, std::chrono::milliseconds timeout = 5000ms) {
 
 std::vector<std::uint8_t> pattern(std::size_t n, int seed) {
   std::vector<std::uint8_t> v(n);
-  for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<std::uint8_t>((i * 31 + static_cast<std::size_t>(seed)) & 0xFF);
+  for (std::size_t i = 0; i < n; ++i)
+    v[i] = static_cast<std::uint8_t>((i * 31 + static_cast<std::size_t>(seed)) & 0xFF);
   return v;
 }
 

@@ -27,13 +27,18 @@
 namespace canyon::app {
 
 struct ConvertConfig {
-  std::string input;          ///< input file ("-": standard input)
+  /// Input: a file, "-" (standard input), "tcp://HOST:PORT" or "ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT" (a
+  /// live stream, recorded until `duration_s` has passed or no byte came for `idle_timeout_s`).
+  std::string input;
   std::string from = "auto";  ///< auto | rtcm3 | ubx | rinex
   // Binary -> RINEX.
   std::string obs_out;                       ///< RINEX observations (default: the input name with .obs)
   std::string nav_out;                       ///< RINEX navigation (default: the input name with .nav)
   std::optional<core::GpsTime> approx_time;  ///< GPST within a few days of the data (RTCM 3 weeks)
   std::string marker;                        ///< RINEX MARKER NAME (default: "RTCM <station id>" or the input name)
+  double duration_s = 0.0;                   ///< network input: record this long (0: until idle)
+  double idle_timeout_s = 5.0;               ///< network input: stop when no byte came for this long (after the first)
+  int ntrip_version = 2;                     ///< network input: NTRIP request version (1 or 2)
   // RINEX -> RTCM 3.
   std::string rtcm_out;                         ///< RTCM 3 output (default: the input name with .rtcm3)
   std::vector<std::string> nav;                 ///< RINEX navigation files whose ephemerides go into the stream
@@ -59,6 +64,18 @@ struct ConvertSummary {
 
 /// Runs the conversion. Error (file, and byte or line) if the input cannot be read or an output cannot be written.
 Result<ConvertSummary> run_convert(const ConvertConfig& config);
+
+/// Where a network input comes from: "tcp://HOST:PORT" or "ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT".
+struct StreamUrl {
+  bool ntrip = false;
+  std::string host;
+  int port = 0;
+  std::string mount;
+  std::string user;
+  std::string password;
+};
+/// nullopt for a plain file name; Error for a malformed URL.
+Result<std::optional<StreamUrl>> parse_stream_url(const std::string& text);
 
 /// "2021-03-19 12:00:00" or "2021/03/19 12:00:00" (GPST) -> GpsTime; nullopt if malformed.
 [[nodiscard]] std::optional<core::GpsTime> parse_gps_calendar(const std::string& text);

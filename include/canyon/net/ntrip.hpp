@@ -27,21 +27,21 @@ namespace canyon::net {
 
 /// One source table record ("STR;...") describing a mount point.
 struct MountPoint {
-  std::string name;                   ///< mount point, e.g. "CANYON0"
-  std::string identifier;             ///< source identifier (place)
+  std::string name;        ///< mount point, e.g. "CANYON0"
+  std::string identifier;  ///< source identifier (place)
   std::string format = "RTCM 3.3";
-  std::string format_details;         ///< e.g. "1005(10),1077(1),1087(1)"
-  int carrier = 2;                    ///< 0 none, 1 L1, 2 L1+L2
-  std::string nav_system;             ///< e.g. "GPS+GLO+GAL+BDS+QZS"
+  std::string format_details;  ///< e.g. "1005(10),1077(1),1087(1)"
+  int carrier = 2;             ///< 0 none, 1 L1, 2 L1+L2
+  std::string nav_system;      ///< e.g. "GPS+GLO+GAL+BDS+QZS"
   std::string network = "canyon";
   std::string country = "XXX";
   double latitude_deg = 0.0;
   double longitude_deg = 0.0;
-  bool nmea = false;                  ///< the client must send GGA
-  bool solution = false;              ///< network solution (false: single base)
+  bool nmea = false;      ///< the client must send GGA
+  bool solution = false;  ///< network solution (false: single base)
   std::string generator = "canyon";
   std::string compression = "none";
-  std::string authentication = "N";   ///< N none, B basic
+  std::string authentication = "N";  ///< N none, B basic
   bool fee = false;
   int bitrate_bps = 0;
 };
@@ -53,14 +53,14 @@ Result<std::vector<MountPoint>> parse_source_table(std::string_view text);
 
 /// A client's request as a caster sees it.
 struct NtripRequest {
-  std::string method;         ///< "GET" (also "SOURCE"/"POST" from NTRIP servers: parsed, refused by canyon)
-  std::string mount;          ///< without the leading '/'; empty: the source table
-  int version = 1;            ///< 2 with "Ntrip-Version: Ntrip/2.0"
+  std::string method;  ///< "GET" (also "SOURCE"/"POST" from NTRIP servers: parsed, refused by canyon)
+  std::string mount;   ///< without the leading '/'; empty: the source table
+  int version = 1;     ///< 2 with "Ntrip-Version: Ntrip/2.0"
   std::string user_agent;
-  std::optional<std::string> user;      ///< from "Authorization: Basic"
+  std::optional<std::string> user;  ///< from "Authorization: Basic"
   std::optional<std::string> password;
   std::string host;
-  std::string nmea;           ///< a GGA sentence in the "Ntrip-GGA" header (v2), if any
+  std::string nmea;  ///< a GGA sentence in the "Ntrip-GGA" header (v2), if any
 };
 /// Largest header canyon reads before refusing a request or response.
 inline constexpr std::size_t kMaxHeaderBytes = 8192;
@@ -72,14 +72,14 @@ Result<NtripRequest> parse_ntrip_request(std::string_view header);
 
 /// A client's request for a mount point (empty mount: the source table).
 struct ClientRequestOptions {
-  std::string host;      ///< caster host name, for "Host:" (v2)
+  std::string host;  ///< caster host name, for "Host:" (v2)
   int port = 2101;
   std::string mount;
-  int version = 2;       ///< 1 or 2
-  std::string user;      ///< empty: no authentication
+  int version = 2;   ///< 1 or 2
+  std::string user;  ///< empty: no authentication
   std::string password;
   std::string user_agent = "NTRIP canyon/0.1";
-  std::string gga;       ///< v2: sent in the "Ntrip-GGA" header when not empty
+  std::string gga;  ///< v2: sent in the "Ntrip-GGA" header when not empty
 };
 [[nodiscard]] std::string format_ntrip_request(const ClientRequestOptions& o);
 
@@ -87,9 +87,9 @@ struct ClientRequestOptions {
 struct NtripResponse {
   enum class Kind : std::uint8_t { Data, SourceTable, Unauthorized, NotFound, Error };
   Kind kind = Kind::Error;
-  int status = 0;             ///< HTTP status (200, 401, 404, ...); 200 for "ICY 200 OK"
-  int version = 1;            ///< 2 if "Ntrip-Version: Ntrip/2.0" or HTTP/1.1 with gnss/data
-  bool chunked = false;       ///< "Transfer-Encoding: chunked"
+  int status = 0;        ///< HTTP status (200, 401, 404, ...); 200 for "ICY 200 OK"
+  int version = 1;       ///< 2 if "Ntrip-Version: Ntrip/2.0" or HTTP/1.1 with gnss/data
+  bool chunked = false;  ///< "Transfer-Encoding: chunked"
   std::optional<std::size_t> content_length;
   std::string status_line;
 };

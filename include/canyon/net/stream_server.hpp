@@ -26,13 +26,13 @@ struct StreamServerOptions {
   enum class Mode : std::uint8_t { Tcp, Ntrip };
   Mode mode = Mode::Tcp;
   std::string bind_host = "0.0.0.0";
-  int port = 0;                                  ///< 0: any free port (see StreamServer::port())
-  std::vector<MountPoint> mounts;                ///< NTRIP: the mount points served
-  std::string user;                              ///< NTRIP: empty, no authentication; else Basic user:password
+  int port = 0;                    ///< 0: any free port (see StreamServer::port())
+  std::vector<MountPoint> mounts;  ///< NTRIP: the mount points served
+  std::string user;                ///< NTRIP: empty, no authentication; else Basic user:password
   std::string password;
   std::size_t max_client_buffer_bytes = 1 << 20;  ///< a slower client is disconnected
   int max_clients = 64;
-  int handshake_timeout_ms = 5000;               ///< NTRIP: the request header must arrive within this time
+  int handshake_timeout_ms = 5000;  ///< NTRIP: the request header must arrive within this time
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;
@@ -45,6 +45,7 @@ struct StreamServerStats {
   std::uint64_t dropped_slow = 0;  ///< disconnected because their buffer overflowed
   std::uint64_t bytes_sent = 0;
   std::uint64_t gga_received = 0;
+  std::size_t pending_bytes = 0;  ///< queued for clients, not sent yet
 };
 
 class StreamServer {
