@@ -31,8 +31,8 @@ core::GpsTime now_gps() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
   gmtime_r(&now, &utc);
-  const core::CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday, utc.tm_hour, utc.tm_min,
-                             static_cast<double>(utc.tm_sec)};
+  const core::CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                             utc.tm_hour,        utc.tm_min,     static_cast<double>(utc.tm_sec)};
   return core::utc_to_gps(c, core::builtin_leap_seconds());
 }
 
@@ -232,9 +232,8 @@ bool BaseStation::pace(const core::GpsTime& t) {
     return !stop_requested();
   }
   if (config_.input.pace <= 0.0 || config_.input.source != BaseInputSource::File) return !stop_requested();
-  const auto target =
-      impl.first_wall + std::chrono::duration_cast<Clock::duration>(
-                            std::chrono::duration<double>((t - *impl.first_epoch) / config_.input.pace));
+  const auto target = impl.first_wall + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                            (t - *impl.first_epoch) / config_.input.pace));
   while (!stop_requested()) {
     const auto now = Clock::now();
     if (now >= target) break;
@@ -336,8 +335,7 @@ Status BaseStation::run_bytes() {
       }
     }
     const io::GnssStreamStats st = decoder.stats();
-    const std::uint64_t problems =
-        st.framing.bad_packets() + st.rtcm3_decode_errors + st.ubx_decode_errors;
+    const std::uint64_t problems = st.framing.bad_packets() + st.rtcm3_decode_errors + st.ubx_decode_errors;
     if (problems > problems_seen) {
       const std::lock_guard lock(impl.stats_mutex);
       impl.stats.input_problems = problems;
@@ -383,7 +381,7 @@ Status BaseStation::run_bytes() {
       std::deque<std::vector<std::uint8_t>> queue;
       net::StreamClientOptions co;
       co.mode = c.input.source == BaseInputSource::Ntrip ? net::StreamClientOptions::Mode::Ntrip
-                                                          : net::StreamClientOptions::Mode::Tcp;
+                                                         : net::StreamClientOptions::Mode::Tcp;
       co.host = c.input.host;
       co.port = c.input.port;
       co.mount = c.input.mountpoint;

@@ -46,7 +46,8 @@ int run(int argc, char** argv) {
                  "Start once this many subscribers (NTRIP, TCP clients, DDS readers) are connected")
       ->check(CLI::NonNegativeNumber);
   cli.add_option("--wait-timeout", wait_timeout_s, "Give up waiting for subscribers after this many seconds");
-  cli.add_option("--ntrip-port", ntrip_port, "Override outputs.ntrip.port (0: any free port)")->check(CLI::Range(0, 65535));
+  cli.add_option("--ntrip-port", ntrip_port, "Override outputs.ntrip.port (0: any free port)")
+      ->check(CLI::Range(0, 65535));
   cli.add_option("--tcp-port", tcp_port, "Override outputs.tcp.port (0: any free port)")->check(CLI::Range(0, 65535));
   cli.add_option("--pace", pace, "Override input.pace (file replay speed; 0 as fast as possible)")
       ->check(CLI::NonNegativeNumber);

@@ -49,9 +49,9 @@ Result<app::BaseFrame> from_msg(const msg::RtcmFrame& m) {
 bool publish_rtcm_frame(RtcmWriter& writer, const app::BaseFrame& frame) {
   msg::RtcmFrame m = to_msg(frame);
   m.send_monotonic_ns(core::pipeline_now_ns());
-  m.send_unix_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::system_clock::now().time_since_epoch())
-                     .count());
+  m.send_unix_ns(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
   return writer.write(m);
 }
 

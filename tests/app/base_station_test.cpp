@@ -2,6 +2,8 @@
 // settings are refused with the rule, and the engine replays RINEX into RTCM 3 that decodes back to the base's
 // observations, over its NTRIP caster and TCP server to canyon's clients.
 
+#include "canyon/app/base_station.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -10,7 +12,6 @@
 #include <gtest/gtest.h>
 
 #include "canyon/app/base_config.hpp"
-#include "canyon/app/base_station.hpp"
 #include "canyon/io/gnss_stream.hpp"
 #include "canyon/io/rinex_obs.hpp"
 #include "canyon/net/stream_client.hpp"

@@ -38,20 +38,20 @@ struct BaseConfig {
   struct Input {
     BaseInputKind kind = BaseInputKind::Rinex;
     BaseInputSource source = BaseInputSource::File;
-    std::string path;                  ///< file (rinex, ubx, rtcm3; may be .gz) or serial device
-    std::vector<std::string> nav;      ///< rinex: navigation files (ephemerides to send)
-    double pace = 1.0;                 ///< file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible
+    std::string path;              ///< file (rinex, ubx, rtcm3; may be .gz) or serial device
+    std::vector<std::string> nav;  ///< rinex: navigation files (ephemerides to send)
+    double pace = 1.0;             ///< file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible
     std::optional<core::GpsTime> approx_time;  ///< rtcm3 input: GPST within days of the data (default: now)
-    int baud = 115200;                 ///< serial
-    std::string host;                  ///< tcp / ntrip
+    int baud = 115200;                         ///< serial
+    std::string host;                          ///< tcp / ntrip
     int port = 0;
-    std::string mountpoint;            ///< ntrip
+    std::string mountpoint;  ///< ntrip
     std::string user;
     std::string password;
   } input;
   struct Rtcm {
-    int msm = 7;                        ///< 7 (MSM7) or 4 (MSM4); 5 and 6 accepted
-    double station_interval_s = 10.0;   ///< 1005/1006 (and 1033) every this many seconds
+    int msm = 7;                         ///< 7 (MSM7) or 4 (MSM4); 5 and 6 accepted
+    double station_interval_s = 10.0;    ///< 1005/1006 (and 1033) every this many seconds
     double ephemeris_interval_s = 60.0;  ///< each current ephemeris again every this many seconds (0: when new)
   } rtcm;
   struct Dds {

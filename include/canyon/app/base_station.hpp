@@ -28,7 +28,7 @@ namespace canyon::app {
 
 /// One RTCM 3 frame as the base sends it.
 struct BaseFrame {
-  std::uint64_t sequence = 0;               ///< 0, 1, 2 ... per base run
+  std::uint64_t sequence = 0;  ///< 0, 1, 2 ... per base run
   int message_number = 0;
   int station_id = 0;
   std::optional<core::GpsTime> epoch_time;  ///< the observation epoch it was sent with

@@ -4,11 +4,12 @@
 
 #include <memory>
 
-#include "RtcmFrame.h"
-#include "RtcmFramePubSubTypes.h"
 #include "canyon/app/base_station.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/pipeline/dds.hpp"
+
+#include "RtcmFrame.h"
+#include "RtcmFramePubSubTypes.h"
 
 namespace canyon::pipeline {
 
