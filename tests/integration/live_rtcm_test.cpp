@@ -35,12 +35,12 @@ const char* const kBaseObs = "3034078M1.21O";
 const char* const kRoverObs = "SEPT078M1.21O";
 const char* const kNav = "SEPT078M.21P";
 
-#define SKIP_WITHOUT_PEERS()                                                                                 \
-  if (!fs::exists(shared_data() / kData / kBaseObs)) {                                                      \
-    GTEST_SKIP() << "shared datasets not found at " << shared_data();                                       \
-  }                                                                                                         \
-  if (test::run_command("command -v convbin && command -v str2str").exit_code != 0) {                      \
-    GTEST_SKIP() << "RTKLIB (convbin, str2str) not installed: apt-get install rtklib";                      \
+#define SKIP_WITHOUT_PEERS()                                                           \
+  if (!fs::exists(shared_data() / kData / kBaseObs)) {                                 \
+    GTEST_SKIP() << "shared datasets not found at " << shared_data();                  \
+  }                                                                                    \
+  if (test::run_command("command -v convbin && command -v str2str").exit_code != 0) {  \
+    GTEST_SKIP() << "RTKLIB (convbin, str2str) not installed: apt-get install rtklib"; \
   }
 
 /// A base configuration replaying the dataset's base at 20x, NTRIP on a free port, TCP optional, no DDS.
@@ -106,7 +106,8 @@ TEST(LiveRtcm, CanyonBaseServesNtripToStr2str) {
   fs::remove(pulled);
   // canyon-base waits for one client, str2str pulls the mount point (NTRIP 1) into a file.
   const std::string script =
-      "cd " + dir.string() + "; " + kBase + " --config base.yaml --wait-for-clients 1 --wait-timeout 20 > base.log 2>&1 & " +
+      "cd " + dir.string() + "; " + kBase +
+      " --config base.yaml --wait-for-clients 1 --wait-timeout 20 > base.log 2>&1 & " +
       "bpid=$!; for i in $(seq 1 100); do grep -q 'NTRIP caster on' base.log && break; sleep 0.1; done; " +
       "port=$(grep -o 'NTRIP caster on [0-9.]*:[0-9]*' base.log | sed 's/.*://'); " +
       "str2str -in ntrip://127.0.0.1:$port/CANYON#rtcm3 -out file://" + pulled.string() + " 2> str2str.log & " +
@@ -119,25 +120,25 @@ TEST(LiveRtcm, CanyonBaseServesNtripToStr2str) {
   ASSERT_TRUE(fs::exists(pulled));
   ASSERT_GT(fs::file_size(pulled), 60000U);
   // RTKLIB decodes what it pulled.
-  const auto decoded = test::run_command("convbin -r rtcm3 -tr \"2021/03/19 12:00:00\" -v 3.04 -od -os -o " +
-                                         (dir / "rtklib.obs").string() + " -n " + (dir / "rtklib.nav").string() +
-                                         " " + pulled.string());
+  const auto decoded =
+      test::run_command("convbin -r rtcm3 -tr \"2021/03/19 12:00:00\" -v 3.04 -od -os -o " +
+                        (dir / "rtklib.obs").string() + " -n " + (dir / "rtklib.nav").string() + " " + pulled.string());
   ASSERT_EQ(decoded.exit_code, 0) << decoded.output;
   expect_base_observations(dir / "rtklib.obs");
 
   // RTK with the base observations that travelled through canyon-base, NTRIP and str2str, decoded by canyon,
   // equals RTK with the base RINEX (GPS + Galileo: QZSS L1 SAIF has no RTCM id).
-  const auto converted = test::run_command(kCanyon + " convert " + pulled.string() + " --obs-out " +
-                                           (dir / "base_rtcm.obs").string() + " --nav-out " +
-                                           (dir / "base_rtcm.nav").string() + " -q");
+  const auto converted =
+      test::run_command(kCanyon + " convert " + pulled.string() + " --obs-out " + (dir / "base_rtcm.obs").string() +
+                        " --nav-out " + (dir / "base_rtcm.nav").string() + " -q");
   ASSERT_EQ(converted.exit_code, 0) << converted.output;
   std::ofstream(dir / "rtk.yaml") << "mode: rtk\nrtk: {systems: [G, E]}\n";
   const fs::path data = shared_data() / kData;
   const std::string common = kCanyon + " process --config " + (dir / "rtk.yaml").string() + " --rover " +
                              (data / kRoverObs).string() + " --nav " + (data / kNav).string() +
                              " --base-pos -3959400.631,3385704.533,3667523.111 --coordinates ecef -q";
-  const auto from_rinex = test::run_command(common + " --base " + (data / kBaseObs).string() + " --out " +
-                                            (dir / "rinex.pos").string());
+  const auto from_rinex =
+      test::run_command(common + " --base " + (data / kBaseObs).string() + " --out " + (dir / "rinex.pos").string());
   ASSERT_EQ(from_rinex.exit_code, 0) << from_rinex.output;
   const auto from_rtcm = test::run_command(common + " --base " + (dir / "base_rtcm.obs").string() + " --out " +
                                            (dir / "rtcm.pos").string());
@@ -155,8 +156,9 @@ TEST(LiveRtcm, CanyonBaseServesNtripToStr2str) {
     max_diff_m = std::max(max_diff_m, ((*a)[k].p_E_m - (*b)[k].p_E_m).norm());
     if ((*a)[k].status == core::SolutionStatus::Fixed) ++fixed;
   }
-  std::cout << "[ rtk      ] 60 epochs, " << fixed << " fixed; largest 3D difference RINEX vs RTCM base: "
-            << max_diff_m * 1000.0 << " mm (.pos resolution 0.1 mm)\n";
+  std::cout << "[ rtk      ] 60 epochs, " << fixed
+            << " fixed; largest 3D difference RINEX vs RTCM base: " << max_diff_m * 1000.0
+            << " mm (.pos resolution 0.1 mm)\n";
   EXPECT_LE(max_diff_m, kMaxRtkDifferenceM);
   EXPECT_GT(fixed, 50);
 }
@@ -175,17 +177,17 @@ RtkComparison rtk_through_rtcm(const fs::path& dir, const fs::path& rover, const
   const auto encoded = test::run_command(kCanyon + " convert " + base.string() + " --nav " + nav.string() + " --out " +
                                          (dir / "base.rtcm3").string() + " -q");
   EXPECT_EQ(encoded.exit_code, 0) << encoded.output;
-  const auto decoded = test::run_command(kCanyon + " convert " + (dir / "base.rtcm3").string() + " --obs-out " +
-                                         (dir / "base_rtcm.obs").string() + " --nav-out " +
-                                         (dir / "base_rtcm.nav").string() + " -q");
+  const auto decoded =
+      test::run_command(kCanyon + " convert " + (dir / "base.rtcm3").string() + " --obs-out " +
+                        (dir / "base_rtcm.obs").string() + " --nav-out " + (dir / "base_rtcm.nav").string() + " -q");
   EXPECT_EQ(decoded.exit_code, 0) << decoded.output;
   std::ofstream(dir / "rtk.yaml") << rtk_yaml;
   const std::string common = kCanyon + " process --config " + (dir / "rtk.yaml").string() + " --rover " +
                              rover.string() + " --nav " + nav.string() + " --base-pos " + base_pos +
                              " --coordinates ecef -q";
   const auto a_run = test::run_command(common + " --base " + base.string() + " --out " + (dir / "rinex.pos").string());
-  const auto b_run =
-      test::run_command(common + " --base " + (dir / "base_rtcm.obs").string() + " --out " + (dir / "rtcm.pos").string());
+  const auto b_run = test::run_command(common + " --base " + (dir / "base_rtcm.obs").string() + " --out " +
+                                       (dir / "rtcm.pos").string());
   EXPECT_EQ(a_run.exit_code, 0) << a_run.output;
   EXPECT_EQ(b_run.exit_code, 0) << b_run.output;
   auto a = io::read_pos_file((dir / "rinex.pos").string());
@@ -209,9 +211,9 @@ TEST(LiveRtcm, RtkThroughRtcmEqualsRtkFromRinexOnAMovingRover) {
   if (!fs::exists(data / "3034265G.21O")) GTEST_SKIP() << "shared datasets not found at " << shared_data();
   for (const std::string ar : {"continuous", "instantaneous"}) {
     const fs::path dir = test::temp_dir("rtk_through_rtcm_" + ar);
-    const RtkComparison c =
-        rtk_through_rtcm(dir, data / "SEPT265G.21O", data / "3034265G.21O", data / "SEPT2650.21P",
-                         "-3959400.631,3385704.533,3667523.111", "mode: rtk\nrtk: {systems: [G, E], ar_mode: " + ar + "}\n");
+    const RtkComparison c = rtk_through_rtcm(dir, data / "SEPT265G.21O", data / "3034265G.21O", data / "SEPT2650.21P",
+                                             "-3959400.631,3385704.533,3667523.111",
+                                             "mode: rtk\nrtk: {systems: [G, E], ar_mode: " + ar + "}\n");
     std::cout << "[ rtk      ] " << ar << ": " << c.epochs << " epochs, " << c.fixed
               << " fixed; largest 3D difference RINEX vs RTCM base: " << c.max_diff_m * 1000.0
               << " mm; status differences " << c.status_differences << "\n";
@@ -223,10 +225,10 @@ TEST(LiveRtcm, RtkThroughRtcmEqualsRtkFromRinexOnAMovingRover) {
   const fs::path m8p = shared_data() / "m8p-galway-20181004/rinex";
   if (!fs::exists(m8p)) return;
   const fs::path dir = test::temp_dir("rtk_through_rtcm_m8p");
-  const RtkComparison c = rtk_through_rtcm(
-      dir, m8p / "20181004_rover-20181004-1532.obs", m8p / "20181004_base-20181004-1452.obs",
-      m8p / "20181004_rover-20181004-1532.nav", "3774094.8387,-601664.2944,5089330.8699",
-      "mode: rtk\nrtk: {systems: [G, R], frequencies: 1}\n");
+  const RtkComparison c =
+      rtk_through_rtcm(dir, m8p / "20181004_rover-20181004-1532.obs", m8p / "20181004_base-20181004-1452.obs",
+                       m8p / "20181004_rover-20181004-1532.nav", "3774094.8387,-601664.2944,5089330.8699",
+                       "mode: rtk\nrtk: {systems: [G, R], frequencies: 1}\n");
   std::cout << "[ rtk      ] m8p L1: " << c.epochs << " epochs, " << c.fixed
             << " fixed; largest 3D difference RINEX vs RTCM base: " << c.max_diff_m * 1000.0
             << " mm; status differences " << c.status_differences << "\n";
@@ -243,12 +245,14 @@ TEST(LiveRtcm, CanyonClientPullsFromStr2strCaster) {
   ASSERT_GT(caster_port, 0);
   // canyon-base (TCP output) -> str2str (TCP client in, NTRIP caster out) -> canyon convert ntrip://.
   const std::string script =
-      "cd " + dir.string() + "; " + kBase + " --config base.yaml --wait-for-clients 1 --wait-timeout 20 > base.log 2>&1 & " +
+      "cd " + dir.string() + "; " + kBase +
+      " --config base.yaml --wait-for-clients 1 --wait-timeout 20 > base.log 2>&1 & " +
       "bpid=$!; for i in $(seq 1 100); do grep -q 'TCP server on' base.log && break; sleep 0.1; done; " +
       "tport=$(grep -o 'TCP server on [0-9.]*:[0-9]*' base.log | sed 's/.*://'); " +
       "str2str -in tcpcli://127.0.0.1:$tport#rtcm3 -out ntripc://:" + std::to_string(caster_port) +
-      "/RTKLIB 2> str2str.log & spid=$!; sleep 0.3; " + kCanyon + " convert ntrip://127.0.0.1:" +
-      std::to_string(caster_port) + "/RTKLIB --ntrip-version 2 --idle-timeout 2 --obs-out canyon.obs --nav-out " +
+      "/RTKLIB 2> str2str.log & spid=$!; sleep 0.3; " + kCanyon +
+      " convert ntrip://127.0.0.1:" + std::to_string(caster_port) +
+      "/RTKLIB --ntrip-version 2 --idle-timeout 2 --obs-out canyon.obs --nav-out " +
       "canyon.nav > convert.log 2>&1; crc=$?; wait $bpid; kill -INT $spid; wait $spid; exit $crc";
   const auto run = run_script(dir, script);
   std::ifstream log(dir / "convert.log");

@@ -2,6 +2,8 @@
 // every frame of a replayed base to several subscribers, in order, and a reader notices when the base goes quiet
 // (deadline of the QoS profile).
 
+#include "canyon/pipeline/rtcm_frame.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -15,7 +17,6 @@
 
 #include "canyon/io/rtcm3.hpp"
 #include "canyon/pipeline/dds.hpp"
-#include "canyon/pipeline/rtcm_frame.hpp"
 
 namespace canyon::pipeline {
 namespace {
