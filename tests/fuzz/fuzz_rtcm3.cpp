@@ -48,8 +48,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   (void)decoder.problems();
   // As one payload of a message type chosen by the second byte, through every decoder and the stateful one twice.
-  static const int kNumbers[] = {1004, 1005, 1006, 1012, 1019, 1020, 1033, 1042, 1044, 1045, 1046, 1074, 1075, 1076,
-                                 1077, 1084, 1087, 1094, 1097, 1114, 1117, 1124, 1127, 1230};
+  static const int kNumbers[] = {1004, 1005, 1006, 1012, 1019, 1020, 1033, 1042, 1044, 1045, 1046, 1074,
+                                 1075, 1076, 1077, 1084, 1087, 1094, 1097, 1114, 1117, 1124, 1127, 1230};
   if (size < 4) return 0;
   std::vector<std::uint8_t> payload(data + 2, data + std::min<std::size_t>(size, 1025));
   const int number = kNumbers[data[1] % (sizeof kNumbers / sizeof kNumbers[0])];
