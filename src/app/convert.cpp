@@ -64,6 +64,7 @@ Result<std::vector<std::uint8_t>> record_stream(const ConvertConfig& config, con
         last = std::chrono::steady_clock::now();
       },
       [&](const std::string& e) {
+        if (e.rfind("connected to", 0) == 0) return;  // not a problem
         const std::lock_guard lock(mutex);
         warnings.push_back(config.input + ": " + e);
       });

@@ -85,9 +85,10 @@ core::SatelliteObs& Rtcm3Decoder::satellite(const core::SatelliteId& sat) {
 std::uint8_t Rtcm3Decoder::lock_lli(const core::SatelliteId& sat, core::SignalCode code, double lock_ms,
                                     double upper_ms, const core::GpsTime& time) {
   LockState& state = locks_.at(sat, code);
-  bool slip = lock_ms <= 0.0 || (state.seen && lock_ms < state.lock_ms);
-  // A gap longer than the lock time can be: lock was lost in between.
-  if (state.seen && (time - state.time) * 1000.0 > upper_ms + 1.0) slip = true;
+  // The first phase of a signal starts an arc, as a lock time of zero does.
+  bool slip = !state.seen || lock_ms <= 0.0 || lock_ms < state.lock_ms;
+  // The lock started after the previous epoch (its upper bound does not reach back to it): lost in between.
+  if (state.seen && (time - state.time) * 1000.0 >= upper_ms - 0.5) slip = true;
   state.lock_ms = lock_ms;
   state.time = time;
   state.seen = true;
@@ -190,16 +191,16 @@ Status Rtcm3Decoder::add_legacy(const rtcm3::LegacyObsMessage& m, Message& out) 
       sig.snr_dbhz = l.cnr_dbhz;
       const auto lambda = core::wavelength_m(m.system, l.code, channel);
       if (lambda && core::has_value(l.phase_range_m)) {
-        double cyc = l.phase_range_m / *lambda;
+        // Phase range minus the L1 pseudorange, in cycles: an encoder keeps it within its field by steps of 1500
+        // cycles; keep it continuous with the previous epoch (within 750 cycles).
+        double diff_cyc = (l.phase_range_m - l.phase_reference_m) / *lambda;
         LockState& state = locks_.at(s.sat, l.code);
-        // The phase-range field rolls over by 1500 cycles: keep the phase continuous with the previous epoch.
         if (core::has_value(state.last_phase_cyc)) {
-          cyc += kLegacyPhaseRollCyc * std::round((state.last_phase_cyc - cyc) / kLegacyPhaseRollCyc);
+          diff_cyc += kLegacyPhaseRollCyc * std::round((state.last_phase_cyc - diff_cyc) / kLegacyPhaseRollCyc);
         }
-        sig.carrier_phase_cyc = cyc;
-        const double lock_ms = l.lock_time_s * 1000.0;
-        sig.lli = lock_lli(s.sat, l.code, lock_ms, std::max(2.0 * lock_ms, 1000.0), time);
-        locks_.at(s.sat, l.code).last_phase_cyc = cyc;
+        sig.carrier_phase_cyc = l.phase_reference_m / *lambda + diff_cyc;
+        sig.lli = lock_lli(s.sat, l.code, l.lock_time_s * 1000.0, l.lock_upper_s * 1000.0, time);
+        locks_.at(s.sat, l.code).last_phase_cyc = diff_cyc;
       }
       obs.signals.push_back(sig);
     }

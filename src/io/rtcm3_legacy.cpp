@@ -71,8 +71,10 @@ Result<LegacyObsMessage> decode_legacy_obs(std::span<const std::uint8_t> payload
     l1.code = core::SignalCode{'1', l1_code != 0 ? 'P' : 'C'};
     l1.pseudorange_m = pr1;
     if (ppr1 != kInvalidPhase) l1.phase_range_m = pr1 + static_cast<double>(ppr1) * kPhaseLsbM;
+    l1.phase_reference_m = pr1;
     if (cnr1 > 0) l1.cnr_dbhz = cnr1 * kCnrLsbDbhz;
     l1.lock_time_s = legacy_lock_time_s(lock1);
+    l1.lock_upper_s = lock1 < 127 ? legacy_lock_time_s(lock1 + 1) : 1e9;
     s.signals.push_back(l1);
 
     LegacySignal l2;
@@ -84,8 +86,10 @@ Result<LegacyObsMessage> decode_legacy_obs(std::span<const std::uint8_t> payload
     }
     if (dpr2 != kInvalidL2Pr) l2.pseudorange_m = pr1 + static_cast<double>(dpr2) * kPrLsbM;
     if (ppr2 != kInvalidPhase) l2.phase_range_m = pr1 + static_cast<double>(ppr2) * kPhaseLsbM;
+    l2.phase_reference_m = pr1;
     if (cnr2 > 0) l2.cnr_dbhz = cnr2 * kCnrLsbDbhz;
     l2.lock_time_s = legacy_lock_time_s(lock2);
+    l2.lock_upper_s = lock2 < 127 ? legacy_lock_time_s(lock2 + 1) : 1e9;
     if (core::has_value(l2.pseudorange_m) || core::has_value(l2.phase_range_m)) s.signals.push_back(l2);
     if (s.sat.valid()) m.satellites.push_back(std::move(s));
   }

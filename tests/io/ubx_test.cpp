@@ -3,6 +3,8 @@
 // NAV-TIMEGPS, and a mixed stream with NMEA, RTCM 3 and garbage. (GPS LNAV and GLONASS strings are checked against
 // RTKLIB on the real u-blox logs in tests/integration.)
 
+#include "canyon/io/ubx.hpp"
+
 #include <cmath>
 #include <vector>
 
@@ -11,7 +13,6 @@
 #include "canyon/io/bits.hpp"
 #include "canyon/io/gnss_stream.hpp"
 #include "canyon/io/rtcm3.hpp"
-#include "canyon/io/ubx.hpp"
 
 namespace canyon::io {
 namespace {
@@ -53,7 +54,8 @@ TEST(Ubx, RawxRoundTripsAndFollowsTheLockRules) {
     return *decoder.pop_epoch();
   };
   // trkStat: 1 pr valid, 2 cp valid, 4 half cycle valid, 8 half cycle subtracted.
-  auto e1 = epoch(399000.5, {measurement(0, 5, 2.1e7, 1.1e8, 5000, 1 | 2 | 4), measurement(6, 7, 2.0e7, 1.0e8, 100, 1 | 2)});
+  auto e1 =
+      epoch(399000.5, {measurement(0, 5, 2.1e7, 1.1e8, 5000, 1 | 2 | 4), measurement(6, 7, 2.0e7, 1.0e8, 100, 1 | 2)});
   ASSERT_EQ(e1.sats.size(), 2U);
   EXPECT_EQ(e1.time, (GpsTime{2021, 399000.5}));
   const core::SignalObs& g = e1.sats[0].signals.at(0);
@@ -71,7 +73,8 @@ TEST(Ubx, RawxRoundTripsAndFollowsTheLockRules) {
   auto e2 = epoch(399001.5, {measurement(0, 5, 2.1e7, 1.1e8, 6000, 1 | 2 | 4), measurement(6, 7, 2.0e7, 1.0e8, 50, 1)});
   EXPECT_EQ(e2.sats[0].signals[0].lli, 0);
   EXPECT_FALSE(core::has_value(e2.sats[1].signals[0].carrier_phase_cyc));
-  auto e3 = epoch(399002.5, {measurement(0, 5, 2.1e7, 1.1e8, 7000, 1 | 2 | 4 | 8), measurement(6, 7, 2.0e7, 1.0e8, 1050, 1 | 2 | 4)});
+  auto e3 = epoch(399002.5, {measurement(0, 5, 2.1e7, 1.1e8, 7000, 1 | 2 | 4 | 8),
+                             measurement(6, 7, 2.0e7, 1.0e8, 1050, 1 | 2 | 4)});
   EXPECT_EQ(e3.sats[0].signals[0].lli, core::kLliLossOfLock);  // half-cycle subtraction changed
   EXPECT_EQ(e3.sats[1].signals[0].lli, core::kLliLossOfLock);  // the slip seen while the phase was invalid
   // Malformed payloads.
@@ -307,9 +310,9 @@ std::vector<std::vector<std::uint32_t>> beidou_subframes(const core::KeplerEphem
     w.u(static_cast<std::uint64_t>(id), 3);
     putu(w, sow + 6.0 * (id - 1), 1, 20);
     if (id == 1) {
-      w.u(0, 1);   // SatH1
-      w.u(9, 5);   // AODC
-      w.u(2, 4);   // URAI
+      w.u(0, 1);  // SatH1
+      w.u(9, 5);  // AODC
+      w.u(2, 4);  // URAI
       w.u(static_cast<std::uint64_t>(bdt_week), 13);
       putu(w, toc_s, 8, 17);
       put(w, e.tgd_s[0], 1e-10, 10);

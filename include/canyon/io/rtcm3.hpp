@@ -204,9 +204,13 @@ Result<core::GlonassEphemeris> decode_glonass_ephemeris(std::span<const std::uin
 struct LegacySignal {
   core::SignalCode code;
   double pseudorange_m = core::kNoValue;
-  double phase_range_m = core::kNoValue;  ///< full phase range (m), near the L1 pseudorange modulo 1500 cycles
+  double phase_range_m = core::kNoValue;  ///< L1 pseudorange + the phase-range field (m); see phase_reference_m
+  /// The L1 pseudorange the phase-range field is relative to: an encoder keeps that difference within its field by
+  /// steps of 1500 cycles, so a decoder keeps (phase range - reference) / wavelength continuous over epochs.
+  double phase_reference_m = core::kNoValue;
   double cnr_dbhz = core::kNoValue;
-  double lock_time_s = 0.0;  ///< minimum lock time the indicator guarantees
+  double lock_time_s = 0.0;   ///< minimum lock time the indicator guarantees
+  double lock_upper_s = 0.0;  ///< the lock time is below this (the next indicator's minimum)
 };
 struct LegacySatellite {
   core::SatelliteId sat;

@@ -13,8 +13,9 @@
 //  - Carrier phase: MSM phase range / wavelength (GLONASS: the FDMA channel from MSM5/7 extended satellite
 //    information, 1020 ephemerides, or the options; without it phase and Doppler are dropped with a warning).
 //    Doppler = -phase range rate / wavelength.
-//  - Loss of lock (core::kLliLossOfLock) when a signal's lock time is zero, smaller than at its previous epoch, or
-//    shorter than the time since its previous epoch (a gap the lock did not survive); kLliHalfCycle from DF420.
+//  - Loss of lock (core::kLliLossOfLock) at a signal's first phase, when its lock time is zero, smaller than at its
+//    previous epoch, or certainly shorter than the time since its previous epoch with phase (the upper bound of its
+//    indicator does not reach back to it: the lock started in between); kLliHalfCycle from DF420.
 //  - Ephemerides are kept once per (satellite, toe, issue of data, data source); a repeated one is not added again.
 //    Their transmission time is the epoch time of the stream when they arrived (toe before any epoch).
 //
@@ -102,7 +103,7 @@ class Rtcm3Decoder {
   struct LockState {
     double lock_ms = 0.0;
     core::GpsTime time;
-    double last_phase_cyc = core::kNoValue;  // legacy messages: continuity of the phase-range field
+    double last_phase_cyc = core::kNoValue;  // legacy messages: (phase range - L1 pseudorange) / wavelength
     bool seen = false;
   };
   Status add_msm(const rtcm3::MsmMessage& msm, Message& out);
