@@ -93,6 +93,7 @@ void GnssStreamDecoder::collect_navigation() {
   for (; ubx_kepler_seen_ < u.kepler.size(); ++ubx_kepler_seen_) nav_.kepler.push_back(u.kepler[ubx_kepler_seen_]);
   for (; ubx_glonass_seen_ < u.glonass.size(); ++ubx_glonass_seen_)
     nav_.glonass.push_back(u.glonass[ubx_glonass_seen_]);
+  if (u.gps_klobuchar) nav_.gps_klobuchar = u.gps_klobuchar;
 }
 
 GnssStreamStats GnssStreamDecoder::stats() const {

@@ -59,7 +59,14 @@ Result<std::optional<core::KeplerEphemeris>> LnavAssembler::add(core::SatelliteI
   if (u(f, 0, 8) != 0x8B) return Error{sat.to_string() + ": LNAV subframe without preamble"};
   const auto id = static_cast<int>(u(f, 43, 3));
   if (id < 1 || id > 5) return Error{sat.to_string() + ": LNAV subframe id " + std::to_string(id) + " not 1-5"};
-  if (id > 3) return std::optional<core::KeplerEphemeris>{};  // almanac, ionosphere, UTC: not used here
+  if (id == 4 && sat.system == Constellation::Gps && u(f, 50, 6) == 56) {
+    // Subframe 4 page 18: ionosphere (IS-GPS-200 20.3.3.5.1.7), seconds per semicircle to the power k.
+    core::KlobucharParams k;
+    k.alpha = {s(f, 56, 8) * p2(-30), s(f, 64, 8) * p2(-27), s(f, 72, 8) * p2(-24), s(f, 80, 8) * p2(-24)};
+    k.beta = {s(f, 88, 8) * p2(11), s(f, 96, 8) * p2(14), s(f, 104, 8) * p2(16), s(f, 112, 8) * p2(16)};
+    klobuchar_ = k;
+  }
+  if (id > 3) return std::optional<core::KeplerEphemeris>{};  // almanac, UTC: not used here
   State& st = state_[sat];
   st.frames[static_cast<std::size_t>(id - 1)] = f;
   st.have[static_cast<std::size_t>(id - 1)] = true;

@@ -283,6 +283,18 @@ void Rtcm3Encoder::set_glonass_channel(int slot, int channel) {
   glonass_channel_[slot] = channel;
 }
 
+std::optional<double> Rtcm3Encoder::wavelength(Constellation system, core::SignalCode code, int channel) {
+  if (system == Constellation::Glonass || code.band < '0' || code.band > '9' || code.attribute < 'A' ||
+      code.attribute > 'Z') {
+    return core::wavelength_m(system, code, channel);
+  }
+  double& cached = wavelength_m_[static_cast<std::size_t>(system)][static_cast<std::size_t>(code.band - '0') * 26 +
+                                                                   static_cast<std::size_t>(code.attribute - 'A')];
+  if (cached == 0.0) cached = core::wavelength_m(system, code).value_or(-1.0);
+  if (cached < 0.0) return std::nullopt;
+  return cached;
+}
+
 namespace {
 
 Result<Rtcm3Frame> framed(int number, const std::vector<std::uint8_t>& payload) {
@@ -337,9 +349,9 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
   if (const std::string broken = options_.validate(); !broken.empty()) return Error{"RTCM 3 encoder: " + broken};
   Rtcm3EncodeReport report;
 
-  // Satellites per constellation, in satellite order.
+  // Satellites per constellation, in satellite order; the scratch objects (and their cell storage) are reused.
   auto& per_system = per_system_;
-  for (auto& v : per_system) v.clear();
+  std::array<std::size_t, core::kNumConstellations> used{};
   for (const core::SatelliteObs& so : epoch.sats) {
     const Constellation system = so.sat.system;
     int channel = core::kNoGlonassChannel;
@@ -347,7 +359,11 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
       const auto it = glonass_channel_.find(so.sat.prn);
       if (it != glonass_channel_.end()) channel = it->second;
     }
-    rtcm3::MsmSatellite ms;
+    auto& slot = per_system[static_cast<std::size_t>(system)];
+    std::size_t& n = used[static_cast<std::size_t>(system)];
+    if (n == slot.size()) slot.emplace_back();
+    rtcm3::MsmSatellite& ms = slot[n];
+    ms.cells.clear();
     ms.satellite_id = so.sat.prn;
     ms.extended_info = system == Constellation::Glonass ? (channel != core::kNoGlonassChannel ? channel + 7 : 15) : 0;
     // Reference range for new arcs: the first pseudorange of the satellite.
@@ -369,7 +385,7 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
       cell.pseudorange_m = s.pseudorange_m;
       cell.cnr_dbhz = s.snr_dbhz;
       cell.half_cycle = (s.lli & core::kLliHalfCycle) != 0;
-      const auto lambda = core::wavelength_m(system, s.code, channel);
+      const std::optional<double> lambda = wavelength(system, s.code, channel);
       if (core::has_value(s.carrier_phase_cyc) || core::has_value(s.doppler_hz)) {
         if (!lambda) ++report.phase_without_channel;
       }
@@ -398,7 +414,7 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
       }
       ms.cells.push_back(cell);
     }
-    if (!ms.cells.empty()) per_system[static_cast<std::size_t>(system)].push_back(std::move(ms));
+    if (!ms.cells.empty()) ++n;
   }
 
   // Messages: per constellation, satellites split so that each message has at most 64 cells.
@@ -408,17 +424,19 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
     std::size_t count;
   };
   std::vector<Pending> pending;
+  pending.reserve(8);
   for (std::size_t k = 0; k < per_system.size(); ++k) {
     auto& sats = per_system[k];
-    std::sort(sats.begin(), sats.end(), [](const rtcm3::MsmSatellite& a, const rtcm3::MsmSatellite& b) {
-      return a.satellite_id < b.satellite_id;
-    });
+    const std::size_t nsat = used[k];
+    std::sort(
+        sats.begin(), sats.begin() + static_cast<std::ptrdiff_t>(nsat),
+        [](const rtcm3::MsmSatellite& a, const rtcm3::MsmSatellite& b) { return a.satellite_id < b.satellite_id; });
     std::size_t first = 0;
-    while (first < sats.size()) {
+    while (first < nsat) {
       // Grow the chunk while satellites x union of signals fits 64 cells.
       std::uint32_t mask = 0;
       std::size_t count = 0;
-      while (first + count < sats.size()) {
+      while (first + count < nsat) {
         std::uint32_t m = mask;
         for (const rtcm3::MsmCell& c : sats[first + count].cells) m |= 1U << (32 - c.signal_id);
         if (static_cast<int>(count + 1) * std::popcount(m) > 64) break;
@@ -432,15 +450,16 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
   }
   for (std::size_t i = 0; i < pending.size(); ++i) {
     const Pending& p = pending[i];
-    rtcm3::MsmMessage msm;
+    rtcm3::MsmMessage& msm = msm_;
+    msm.header = rtcm3::MsmHeader{};
     msm.header.system = p.system;
     msm.header.type = options_.msm_type;
     msm.header.station_id = options_.station_id;
     msm.header.epoch_time = rtcm3::msm_epoch_field(p.system, epoch.time, options_.leaps);
     msm.header.multiple_message = i + 1 < pending.size();
     auto& sats = per_system[static_cast<std::size_t>(p.system)];
-    msm.satellites.assign(sats.begin() + static_cast<std::ptrdiff_t>(p.first),
-                          sats.begin() + static_cast<std::ptrdiff_t>(p.first + p.count));
+    msm.satellites.resize(p.count);
+    for (std::size_t k = 0; k < p.count; ++k) msm.satellites[k] = sats[p.first + k];  // reuses cell storage
     payload_.clear();
     auto encoded = rtcm3::append_msm(msm, payload_);
     if (!encoded) return encoded.error();
@@ -450,6 +469,7 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
     Rtcm3Frame frame;
     frame.message_number = rtcm3::msm_message_number(p.system, options_.msm_type);
     frame.epoch_time = epoch.time;
+    frame.bytes.reserve(payload_.size() + 6);
     if (Status s = rtcm3::append_frame(payload_, frame.bytes); !s.ok()) return s.error();
     out.push_back(std::move(frame));
     ++report.messages;

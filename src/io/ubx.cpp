@@ -401,6 +401,7 @@ Status UbxDecoder::add_sfrbx(const ubx::Sfrbx& s, Message& out) {
         f[3 * k + 2] = static_cast<std::uint8_t>(data);
       }
       auto r = lnav_.add(*sat, f, *reference);
+      if (lnav_.klobuchar()) nav_.gps_klobuchar = lnav_.klobuchar();
       if (!r) {
         note(r.error());
       } else if (*r) {

@@ -236,6 +236,15 @@ TEST(UbxRtklib, RoverLogDecodesToRtklibsRinex) {
   EXPECT_EQ(n.records_a, n.records_b);
   EXPECT_EQ(n.matched, n.records_a);
   EXPECT_EQ(n.mismatched, 0);
+  // The ionosphere of subframe 4 page 18, in RTKLIB's navigation header.
+  const core::NavigationData rtklib_nav = read_nav(dir / kRover.nav);
+  ASSERT_TRUE(rtklib_nav.gps_klobuchar && d.nav.gps_klobuchar);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(d.nav.gps_klobuchar->alpha[i], rtklib_nav.gps_klobuchar->alpha[i],
+                1e-3 * std::abs(rtklib_nav.gps_klobuchar->alpha[i]));  // RTKLIB prints 4 digits
+    EXPECT_NEAR(d.nav.gps_klobuchar->beta[i], rtklib_nav.gps_klobuchar->beta[i],
+                1e-3 * std::abs(rtklib_nav.gps_klobuchar->beta[i]));
+  }
 }
 
 TEST(UbxRtklib, CorruptBaseLogDecodesEveryRtklibEpochAndMore) {

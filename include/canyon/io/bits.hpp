@@ -155,9 +155,24 @@ class FixedBitWriter {
   void u(std::uint64_t value, unsigned n) {
     assert(n <= 64);
     if (n > 32) {
-      u(value >> 32, n - 32);
+      put(value >> 32, n - 32);
       n = 32;
     }
+    put(value, n);
+  }
+  void s(std::int64_t value, unsigned n) { u(static_cast<std::uint64_t>(value), n); }
+  void flush() {
+    while (pending_ >= 8) {
+      pending_ -= 8;
+      *p_++ = static_cast<std::uint8_t>(acc_ >> pending_);
+    }
+    if (pending_ > 0) *p_++ = static_cast<std::uint8_t>(acc_ << (8 - pending_));
+    pending_ = 0;
+  }
+
+ private:
+  /// At most 32 bits (not recursive, so that it inlines).
+  void put(std::uint64_t value, unsigned n) {
     value &= (std::uint64_t{1} << n) - 1;
     acc_ = (acc_ << n) | value;  // fewer than 32 pending bits + at most 32 new ones
     pending_ += n;
@@ -171,17 +186,7 @@ class FixedBitWriter {
       p_ += 4;
     }
   }
-  void s(std::int64_t value, unsigned n) { u(static_cast<std::uint64_t>(value), n); }
-  void flush() {
-    while (pending_ >= 8) {
-      pending_ -= 8;
-      *p_++ = static_cast<std::uint8_t>(acc_ >> pending_);
-    }
-    if (pending_ > 0) *p_++ = static_cast<std::uint8_t>(acc_ << (8 - pending_));
-    pending_ = 0;
-  }
 
- private:
   std::uint8_t* p_;
   std::uint64_t acc_ = 0;
   unsigned pending_ = 0;

@@ -31,6 +31,8 @@ class LnavAssembler {
   /// differ from the last one returned. Error for a subframe that cannot be valid (preamble, subframe id).
   Result<std::optional<core::KeplerEphemeris>> add(core::SatelliteId sat, const Subframe& subframe,
                                                    const core::GpsTime& reference);
+  /// Klobuchar parameters of the last subframe 4 page 18 (GPS) seen, if any.
+  [[nodiscard]] const std::optional<core::KlobucharParams>& klobuchar() const { return klobuchar_; }
 
  private:
   struct State {
@@ -40,6 +42,7 @@ class LnavAssembler {
     long long last_toe = -1;
   };
   std::map<core::SatelliteId, State> state_;
+  std::optional<core::KlobucharParams> klobuchar_;
 };
 
 /// GLONASS strings: 85 bits (b85 .. b1, b85 the idle chip) in 11 bytes, most significant first.

@@ -193,9 +193,14 @@ class Rtcm3Encoder {
     core::GpsTime start;      // lock start
     bool valid = false;
   };
+  /// Wavelength of a signal (cached per system and code; GLONASS: per channel, not cached).
+  std::optional<double> wavelength(core::Constellation system, core::SignalCode code, int channel);
+
   Rtcm3EncoderOptions options_;
   std::map<int, int> glonass_channel_;
   SignalTable<Arc> arcs_;
+  std::array<std::array<double, 260>, core::kNumConstellations> wavelength_m_{};       // 0: not looked up, < 0: none
+  rtcm3::MsmMessage msm_;                                                              // scratch
   std::array<std::vector<rtcm3::MsmSatellite>, core::kNumConstellations> per_system_;  // scratch
   std::vector<std::uint8_t> payload_;                                                  // scratch
 };
