@@ -79,10 +79,10 @@ Result<std::vector<std::uint8_t>> record_stream(const ConvertConfig& config, con
     if (client.finished()) break;
   }
   client.stop();
+  const std::string last_error = client.stats().last_error;
   const std::lock_guard lock(mutex);
   if (bytes.empty()) {
-    return Error{"no data received" + (warnings.empty() ? std::string() : " (" + warnings.back() + ")"), config.input,
-                 0};
+    return Error{"no data received" + (last_error.empty() ? std::string() : " (" + last_error + ")"), config.input, 0};
   }
   return bytes;
 }

@@ -468,6 +468,10 @@ int run_main(int argc, char** argv) {
   add_demo_command(app, demo_args);
   ConvertArgs convert_args;
   add_convert_command(app, convert_args);
+  // Listed for --help only: `canyon base ...` runs canyon-base before the command line is parsed (main()).
+  app.add_subcommand("base",
+                     "Base station publishing RTCM 3 on DDS, NTRIP and TCP (runs canyon-base; canyon base --help)")
+      ->allow_extras();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
