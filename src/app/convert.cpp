@@ -52,7 +52,9 @@ Result<std::vector<std::uint8_t>> record_stream(const ConvertConfig& config, con
   o.ntrip_version = config.ntrip_version;
   o.max_attempts = 3;
   o.backoff_min_s = 0.5;
-  o.stall_timeout_s = std::max(config.idle_timeout_s, 1.0);
+  // A recording ends on its idle timeout; the client's stall detection (a reconnection) only serves a stream that
+  // has not started yet or broke off, so it waits longer.
+  o.stall_timeout_s = std::max(2.0 * config.idle_timeout_s, 10.0);
   std::mutex mutex;
   std::vector<std::uint8_t> bytes;
   auto last = std::chrono::steady_clock::now();

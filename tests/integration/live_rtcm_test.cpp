@@ -242,18 +242,20 @@ TEST(LiveRtcm, CanyonClientPullsFromStr2strCaster) {
   const fs::path dir = test::temp_dir("live_str2str_caster");
   write_base_config(dir, true);
   const int caster_port = free_port();
+  const int tcp_port = free_port();
   ASSERT_GT(caster_port, 0);
-  // canyon-base (TCP output) -> str2str (TCP client in, NTRIP caster out) -> canyon convert ntrip://.
+  ASSERT_GT(tcp_port, 0);
+  // canyon-base (TCP output) -> str2str (TCP client in, NTRIP caster out) -> canyon convert ntrip://. The caster
+  // drops what arrives before a client is connected: str2str and canyon's client start first, canyon-base last
+  // (it waits for str2str's TCP connection, retried every 200 ms).
   const std::string script =
-      "cd " + dir.string() + "; " + kBase +
-      " --config base.yaml --wait-for-clients 1 --wait-timeout 20 > base.log 2>&1 & " +
-      "bpid=$!; for i in $(seq 1 100); do grep -q 'TCP server on' base.log && break; sleep 0.1; done; " +
-      "tport=$(grep -o 'TCP server on [0-9.]*:[0-9]*' base.log | sed 's/.*://'); " +
-      "str2str -in tcpcli://127.0.0.1:$tport#rtcm3 -out ntripc://:" + std::to_string(caster_port) +
-      "/RTKLIB 2> str2str.log & spid=$!; sleep 0.3; " + kCanyon +
-      " convert ntrip://127.0.0.1:" + std::to_string(caster_port) +
-      "/RTKLIB --ntrip-version 2 --idle-timeout 2 --obs-out canyon.obs --nav-out " +
-      "canyon.nav > convert.log 2>&1; crc=$?; wait $bpid; kill -INT $spid; wait $spid; exit $crc";
+      "cd " + dir.string() + "; str2str -in tcpcli://127.0.0.1:" + std::to_string(tcp_port) +
+      "#rtcm3 -out ntripc://:" + std::to_string(caster_port) + "/RTKLIB -r 200 2> str2str.log & spid=$!; sleep 0.3; " +
+      kCanyon + " convert ntrip://127.0.0.1:" + std::to_string(caster_port) +
+      "/RTKLIB --ntrip-version 2 --idle-timeout 2 --obs-out canyon.obs --nav-out canyon.nav > convert.log 2>&1 & " +
+      "cpid=$!; sleep 1; " + kBase + " --config base.yaml --tcp-port " + std::to_string(tcp_port) +
+      " --wait-for-clients 1 --wait-timeout 20 > base.log 2>&1; brc=$?; wait $cpid; crc=$?; kill -INT $spid; " +
+      "wait $spid; [ $brc -eq 0 ] && exit $crc; exit $brc";
   const auto run = run_script(dir, script);
   std::ifstream log(dir / "convert.log");
   const std::string convert_log((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
