@@ -2,14 +2,17 @@
 // 2 bad command line or configuration.
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include "canyon/app/convert.hpp"
 #include "canyon/app/demo.hpp"
 #include "canyon/app/evaluate.hpp"
 #include "canyon/app/process.hpp"
@@ -426,6 +429,96 @@ int run_demo_command(DemoArgs& args) {
   return 0;
 }
 
+struct ConvertArgs {
+  canyon::app::ConvertConfig config;
+  std::string time;
+  std::string position;
+  bool quiet = false;
+  bool verbose = false;
+};
+
+void add_convert_command(CLI::App& app, ConvertArgs& args) {
+  CLI::App* cmd = app.add_subcommand(
+      "convert", "RTCM 3 or u-blox UBX (file or stdin) -> RINEX 3 observations and navigation; RINEX -> RTCM 3");
+  canyon::app::ConvertConfig& c = args.config;
+  cmd->add_option("input", c.input,
+                  "Input: RTCM 3 / UBX stream file (may be .gz; '-' reads stdin; tcp://HOST:PORT or "
+                  "ntrip://[USER[:PASS]@]HOST:PORT/MOUNT records a live stream) or RINEX observations")
+      ->required();
+  cmd->add_option("--from", c.from, "Input format: auto (default), rtcm3, ubx or rinex")
+      ->check(CLI::IsMember({"auto", "rtcm3", "ubx", "rinex"}));
+  cmd->add_option("--obs-out", c.obs_out, "RINEX observation output (default: INPUT.obs)");
+  cmd->add_option("--nav-out", c.nav_out, "RINEX navigation output (default: INPUT.nav)");
+  cmd->add_option("--time", args.time,
+                  "Approximate GPST of the data, 'YYYY-MM-DD HH:MM:SS' (RTCM 3 weeks; default: from an ephemeris in "
+                  "the stream, else the current date)");
+  cmd->add_option("--marker", c.marker, "RINEX marker name");
+  cmd->add_option("--duration", c.duration_s, "Network input: record this many seconds (default: until idle)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--idle-timeout", c.idle_timeout_s,
+                  "Network input: stop when no byte came for this many seconds (default 5)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--ntrip-version", c.ntrip_version, "Network input: NTRIP request version, 1 or 2 (default 2)")
+      ->check(CLI::IsMember({1, 2}));
+  cmd->add_option("--out", c.rtcm_out, "RTCM 3 output of a RINEX input (default: INPUT.rtcm3)");
+  cmd->add_option("--nav", c.nav, "RINEX navigation file whose ephemerides go into the RTCM 3 stream (repeat)");
+  cmd->add_option("--station-id", c.station_id, "RTCM 3 reference station id, 0-4095 (default 0)")
+      ->check(CLI::Range(0, 4095));
+  cmd->add_option("--msm", c.msm, "MSM type: 7 (default) or 4 (also 5, 6)")->check(CLI::Range(4, 7));
+  cmd->add_option("--station-interval", c.station_interval_s, "1005 every this many seconds (0: once; default 10)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--ephemeris-interval", c.ephemeris_interval_s,
+                  "Repeat each current ephemeris every this many seconds (default 0: each once, when current)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--position", args.position, "1005 antenna position ECEF X,Y,Z in metres (default: RINEX header)");
+  cmd->add_flag("-q,--quiet", args.quiet, "No summary line");
+  cmd->add_flag("-v,--verbose", args.verbose, "Every warning (default: the first five)");
+  cmd->footer("Exit status: 0 success, 1 bad input (file and byte or line named), 2 bad command line.");
+}
+
+int run_convert_command(ConvertArgs& args) {
+  canyon::app::ConvertConfig& c = args.config;
+  if (!args.time.empty()) {
+    c.approx_time = canyon::app::parse_gps_calendar(args.time);
+    if (!c.approx_time) {
+      std::cerr << "canyon: error: --time must be 'YYYY-MM-DD HH:MM:SS', not '" << args.time << "'\n";
+      return kExitUsage;
+    }
+  }
+  if (!args.position.empty()) {
+    double x = 0, y = 0, z = 0;
+    char tail = 0;
+    if (std::sscanf(args.position.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &tail) != 3) {
+      std::cerr << "canyon: error: --position must be X,Y,Z (ECEF metres), not '" << args.position << "'\n";
+      return kExitUsage;
+    }
+    c.position_E_m = Eigen::Vector3d(x, y, z);
+  }
+  if (const std::string e = c.validate(); !e.empty()) {
+    std::cerr << "canyon: error: " << e << "\n";
+    return kExitUsage;
+  }
+  auto summary = canyon::app::run_convert(c);
+  if (!summary) {
+    std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
+    return kExitInput;
+  }
+  constexpr std::size_t kMaxWarningsShown = 5;
+  for (std::size_t i = 0; i < summary->warnings.size() && (args.verbose || i < kMaxWarningsShown); ++i) {
+    std::fprintf(stderr, "canyon: warning: %s\n", summary->warnings[i].c_str());
+  }
+  if (!args.verbose && summary->warnings.size() > kMaxWarningsShown) {
+    std::fprintf(stderr, "canyon: warning: ... and %zu more (-v shows all)\n",
+                 summary->warnings.size() - kMaxWarningsShown);
+  }
+  if (!args.quiet) {
+    std::fprintf(stderr, "canyon convert: %s: %d epochs, %d ephemerides; %s\n", summary->direction.c_str(),
+                 summary->epochs, summary->ephemerides, summary->statistics.c_str());
+    for (const std::string& path : summary->written) std::fprintf(stderr, "canyon convert: wrote %s\n", path.c_str());
+  }
+  return 0;
+}
+
 int run_main(int argc, char** argv) {
   CLI::App app{"canyon: centimetre-level GNSS carrier-phase positioning fused with visual-inertial odometry"};
   app.require_subcommand(1);
@@ -437,6 +530,12 @@ int run_main(int argc, char** argv) {
   add_evaluate_command(app, evaluate_args);
   DemoArgs demo_args;
   add_demo_command(app, demo_args);
+  ConvertArgs convert_args;
+  add_convert_command(app, convert_args);
+  // Listed for --help only: `canyon base ...` runs canyon-base before the command line is parsed (main()).
+  app.add_subcommand("base",
+                     "Base station publishing RTCM 3 on DDS, NTRIP and TCP (runs canyon-base; canyon base --help)")
+      ->allow_extras();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -451,12 +550,39 @@ int run_main(int argc, char** argv) {
   if (app.got_subcommand("simulate")) return run_simulate_command(simulate_args);
   if (app.got_subcommand("evaluate")) return run_evaluate_command(evaluate_args);
   if (app.got_subcommand("demo")) return run_demo_command(demo_args);
+  if (app.got_subcommand("convert")) return run_convert_command(convert_args);
   return kExitUsage;
 }
 
 }  // namespace
 
+/// `canyon base ...` runs `canyon-base ...` (the DDS executable next to this one) with the same arguments.
+int exec_dds_command(const std::string& command, int argc, char** argv) {
+  char self[4096];
+  const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+  std::string dir = ".";
+  if (n > 0) {
+    self[n] = '\0';
+    dir = self;
+    dir = dir.substr(0, dir.find_last_of('/'));
+  }
+  const std::string program = dir + "/canyon-" + command;
+  if (access(program.c_str(), X_OK) != 0) {
+    std::cerr << "canyon: error: '" << command << "' runs " << program
+              << ", which is missing (build it: cmake --build build --target canyon-" << command << ")\n";
+    return kExitUsage;
+  }
+  std::vector<char*> args;
+  args.push_back(const_cast<char*>(program.c_str()));
+  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  execv(program.c_str(), args.data());
+  std::cerr << "canyon: error: cannot run " << program << ": " << std::strerror(errno) << "\n";
+  return kExitInput;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "base") return exec_dds_command("base", argc, argv);
   // Bad input is reported through Result; an exception here is a bug or resource exhaustion: say so and fail.
   try {
     return run_main(argc, argv);

@@ -1,4 +1,5 @@
-# Proves that the estimation core (modules 1-6: core io gnss rtk fusion sim eval) uses no DDS middleware:
+# Proves that the estimation core (modules 1-6: core io gnss rtk fusion sim eval), the network module (net) and the
+# batch application layer (app) use no DDS middleware:
 #  1. no library canyon_<module> links fastrtps, fastcdr, foonathan_memory or canyon_msgs, directly or
 #     transitively (LINK_FILE: closures written at configure time by tests/build/NoDds.cmake);
 #  2. no header under include/canyon/<module>/ and no source under src/<module>/ includes a Fast DDS / Fast CDR
@@ -10,7 +11,7 @@ foreach(var LINK_FILE SOURCE_DIR)
   endif()
 endforeach()
 
-set(core_modules core io gnss rtk fusion sim eval)
+set(core_modules core io net gnss rtk fusion sim eval app)
 set(failures)
 
 # 1. Link closures.
