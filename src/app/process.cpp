@@ -13,6 +13,7 @@
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/io/nmea.hpp"
+#include "canyon/io/obs_read_ahead.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
 #include "canyon/io/vio_file.hpp"
@@ -25,11 +26,12 @@ constexpr std::size_t kMaxEpochNotes = 100;
 
 /// An observation file read epoch by epoch as observations: flag 6 epochs hold cycle-slip records (slip counts in
 /// the observation fields), not observations, and are dropped; after a power failure (flag 1) every phase may have
-/// slipped and gets the loss-of-lock bit. Streaming keeps memory flat however long the file is.
+/// slipped and gets the loss-of-lock bit. Streaming keeps memory flat however long the file is; the file is parsed
+/// ahead on a thread of its own (io::ObsReadAhead), which changes nothing but the wall time.
 class ObservationStream {
  public:
   static Result<ObservationStream> open(const std::string& path, const io::ObsFilter& filter) {
-    auto reader = io::RinexObsReader::open(path, filter);
+    auto reader = io::ObsReadAhead::open(path, filter);
     if (!reader) return reader.error();
     return ObservationStream(std::move(*reader), path);
   }
@@ -62,9 +64,10 @@ class ObservationStream {
   [[nodiscard]] const std::optional<core::GpsTime>& first_time() const { return first_time_; }
   [[nodiscard]] const std::optional<core::GpsTime>& last_time() const { return last_time_; }
 
-  /// The reader's warnings and one for each kind of epoch handled above (call at the end).
-  void append_warnings(std::vector<std::string>& out) const {
-    out.insert(out.end(), reader_.warnings().begin(), reader_.warnings().end());
+  /// The reader's warnings and one for each kind of epoch handled above (call at the end: it stops the reading).
+  void append_warnings(std::vector<std::string>& out) {
+    const std::vector<std::string> warnings = reader_.finish();
+    out.insert(out.end(), warnings.begin(), warnings.end());
     if (slip_records_ > 0) {
       out.push_back(path_ + ": " + std::to_string(slip_records_) +
                     " epochs of cycle-slip records (flag 6) are not observations, not used");
@@ -76,9 +79,9 @@ class ObservationStream {
   }
 
  private:
-  ObservationStream(io::RinexObsReader reader, std::string path) : reader_(std::move(reader)), path_(std::move(path)) {}
+  ObservationStream(io::ObsReadAhead reader, std::string path) : reader_(std::move(reader)), path_(std::move(path)) {}
 
-  io::RinexObsReader reader_;
+  io::ObsReadAhead reader_;
   std::string path_;
   int slip_records_ = 0;
   int power_failures_ = 0;
@@ -106,7 +109,7 @@ class BaseCursor {
     return nullptr;
   }
 
-  [[nodiscard]] const ObservationStream& stream() const { return stream_; }
+  [[nodiscard]] ObservationStream& stream() { return stream_; }
 
  private:
   Status read_next() {
@@ -487,36 +490,40 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   ProcessConfig config = input_config;
   ProcessSummary summary;
 
+  // The observation files start parsing on their own threads while the navigation files are read; errors are
+  // still reported navigation first.
+  const io::ObsFilter filter = observation_filter(config);
+  auto rover = ObservationStream::open(config.rover_obs, filter);
+  std::optional<Result<ObservationStream>> base_stream;
+  if (config.mode != ProcessMode::Spp) base_stream.emplace(ObservationStream::open(config.base_obs, filter));
+
   auto nav = read_navigation(config.nav, summary.warnings);
   if (!nav) return nav.error();
   const gnss::EphemerisStore ephemerides(std::move(*nav));
 
-  const io::ObsFilter filter = observation_filter(config);
   auto excluded = exclude_most_observed(config, filter);
   if (!excluded) return excluded.error();
   summary.excluded_most_observed = std::move(*excluded);
-  auto rover = ObservationStream::open(config.rover_obs, filter);
   if (!rover) return rover.error();
 
   std::optional<BaseCursor> base;
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
-  if (config.mode != ProcessMode::Spp) {
-    auto base_stream = ObservationStream::open(config.base_obs, filter);
-    if (!base_stream) return base_stream.error();
+  if (base_stream) {
+    if (!*base_stream) return base_stream->error();
     if (config.base_position_E_m) {
       p_E_base = *config.base_position_E_m;
-    } else if (base_stream->header().receiver.approx_position_E_m) {
-      p_E_base = *base_stream->header().receiver.approx_position_E_m;
+    } else if ((*base_stream)->header().receiver.approx_position_E_m) {
+      p_E_base = *(*base_stream)->header().receiver.approx_position_E_m;
     } else {
       return Error{
           "no base position: the base file has no APPROX POSITION XYZ; give --base-pos X,Y,Z or "
           "'base_position:'",
           config.base_obs, 0};
     }
-    if (std::string w = glonass_ar_warning(config, rover->header(), base_stream->header()); !w.empty()) {
+    if (std::string w = glonass_ar_warning(config, rover->header(), (*base_stream)->header()); !w.empty()) {
       summary.warnings.push_back(std::move(w));
     }
-    base.emplace(std::move(*base_stream));
+    base.emplace(std::move(**base_stream));
   }
 
   auto pos = io::PosWriter::create(
@@ -542,7 +549,7 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   if (Status c = outputs.close(); !c) return c.error();
   rover->append_warnings(summary.warnings);
   if (base) {
-    const ObservationStream& b = base->stream();
+    ObservationStream& b = base->stream();
     b.append_warnings(summary.warnings);
     if (rover->first_time() && b.first_time() && std::abs(*rover->first_time() - *b.first_time()) > 86400.0 &&
         std::abs(*rover->last_time() - *b.last_time()) > 86400.0) {
