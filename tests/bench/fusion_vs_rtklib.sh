@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue 5's figures, reproduced in one run: RTKLIB 2.4.3, canyon rtk and canyon fusion side by side.
 #  1. Simulated scenarios (canyon simulate, seeds SEEDS): RTKLIB `rnx2rtkp -k config/rtklib/sim.conf`, canyon `process
-#     --mode rtk` with config/rtk.yaml and `ionosphere: estimate` (canyon's best RTK on these 20 km baselines), canyon
+#     --mode rtk` with config/rtk-urban.yaml (canyon's RTK for street canyons; the ionosphere is estimated on these
+#     20 km baselines by `ionosphere: auto`), canyon
 #     `process --mode fusion --config config/fusion.yaml`; all scored by `canyon evaluate` against truth.csv: fix rate
 #     (fixed / rover epochs), availability, wrong fixes (fixed, 3D error > 0.10 m), 3D RMSE of all solved epochs, and
 #     the wall time of each program on the same files (RTKLIB / fusion = how much faster fusion is).
@@ -38,8 +39,6 @@ if [[ ${KEEP:-0} == 1 ]]; then
 else
   trap 'rm -rf "$tmp"' EXIT
 fi
-sed 's/^\( *ionosphere:\) off /\1 estimate /' "$root/config/rtk.yaml" >"$tmp/rtk.yaml"
-grep -q "ionosphere: estimate" "$tmp/rtk.yaml" || { echo "error: could not switch ionosphere in rtk.yaml" >&2; exit 2; }
 
 # variant NAME "fusion: overrides" "rtk: overrides": config/fusion.yaml with keys replaced.
 variant() {
@@ -100,7 +99,7 @@ for scenario in "${scenarios[@]}"; do
     "$canyon" simulate -q --scenario "$scenario" --seed "$seed" --out "$dir"
     timed "$dir/rtklib.time" rnx2rtkp -k "$conf" -o "$dir/rtklib.pos" "$dir/rover.obs" "$dir/base.obs" \
       "$dir/nav.rnx" >/dev/null 2>&1 || true
-    timed "$dir/rtk.time" "$canyon" process -q --config "$tmp/rtk.yaml" --rover "$dir/rover.obs" \
+    timed "$dir/rtk.time" "$canyon" process -q --config "$root/config/rtk-urban.yaml" --rover "$dir/rover.obs" \
       --base "$dir/base.obs" --nav "$dir/nav.rnx" --out "$dir/rtk.pos" || true
     timed "$dir/fusion.time" "$canyon" process -q --config "$tmp/fusion-full.yaml" --rover "$dir/rover.obs" \
       --base "$dir/base.obs" --nav "$dir/nav.rnx" --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" \
