@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <condition_variable>
 #include <deque>
+#include <iterator>
 #include <mutex>
 #include <utility>
 
@@ -18,6 +19,9 @@ struct ObsReadAheadItem {
 };
 
 struct ObsReadAhead::Shared {
+  /// Epochs handed over at a time: one lock and at most one wake-up per batch, not per epoch.
+  static constexpr std::size_t kBatch = 16;
+
   explicit Shared(RinexObsReader r, std::size_t d) : reader(std::move(r)), depth(d) {}
 
   RinexObsReader reader;  // used by the reading thread only until it has ended
@@ -25,23 +29,28 @@ struct ObsReadAhead::Shared {
   std::mutex mutex;
   std::condition_variable not_empty;
   std::condition_variable not_full;
-  std::deque<ObsReadAheadItem> queue;
-  bool stopping = false;  // the consumer wants no more epochs
-  bool ended = false;     // the reading thread has returned its last item
+  std::deque<ObsReadAheadItem> queue;  // guarded by mutex
+  bool stopping = false;               // the consumer wants no more epochs
+  bool ended = false;                  // the reading thread has handed over its last item
+  std::deque<ObsReadAheadItem> taken;  // the consumer's side: items taken from `queue`, not yet returned
 
   /// The reading thread: epochs into the queue until the end of the file, an error, or stop().
   void run() {
-    for (;;) {
+    std::deque<ObsReadAheadItem> batch;
+    bool last = false;
+    while (!last) {
       auto epoch = reader.next();
-      const bool last = !epoch || !*epoch;
-      ObsReadAheadItem item{std::move(epoch), reader.fraction_read(), reader.warnings().size()};
+      last = !epoch || !*epoch;
+      batch.push_back({std::move(epoch), reader.fraction_read(), reader.warnings().size()});
+      if (batch.size() < std::min(kBatch, depth) && !last) continue;
       std::unique_lock lock(mutex);
       not_full.wait(lock, [this] { return stopping || queue.size() < depth; });
       if (stopping) break;
-      queue.push_back(std::move(item));
-      if (last) break;
+      const bool was_empty = queue.empty();
+      std::move(batch.begin(), batch.end(), std::back_inserter(queue));
+      batch.clear();
       lock.unlock();
-      not_empty.notify_one();
+      if (was_empty) not_empty.notify_one();
     }
     const std::lock_guard lock(mutex);
     ended = true;
@@ -88,13 +97,18 @@ void ObsReadAhead::stop() {
 }
 
 Result<std::optional<core::ObsEpoch>> ObsReadAhead::next() {
-  std::unique_lock lock(shared_->mutex);
-  shared_->not_empty.wait(lock, [this] { return !shared_->queue.empty() || shared_->ended || shared_->stopping; });
-  if (shared_->queue.empty()) return std::optional<core::ObsEpoch>{};
-  ObsReadAheadItem item = std::move(shared_->queue.front());
-  shared_->queue.pop_front();
-  lock.unlock();
-  shared_->not_full.notify_one();
+  std::deque<ObsReadAheadItem>& taken = shared_->taken;
+  if (taken.empty()) {
+    std::unique_lock lock(shared_->mutex);
+    shared_->not_empty.wait(lock, [this] { return !shared_->queue.empty() || shared_->ended || shared_->stopping; });
+    if (shared_->stopping) return std::optional<core::ObsEpoch>{};
+    taken.swap(shared_->queue);
+    lock.unlock();
+    shared_->not_full.notify_one();
+    if (taken.empty()) return std::optional<core::ObsEpoch>{};
+  }
+  ObsReadAheadItem item = std::move(taken.front());
+  taken.pop_front();
   fraction_read_ = item.fraction_read;
   warnings_returned_ = item.warnings;
   return std::move(item.epoch);
@@ -103,6 +117,7 @@ Result<std::optional<core::ObsEpoch>> ObsReadAhead::next() {
 std::vector<std::string> ObsReadAhead::finish() {
   if (!shared_) return {};
   stop();
+  shared_->taken.clear();
   const std::vector<std::string>& all = shared_->reader.warnings();
   return {all.begin(), all.begin() + static_cast<std::ptrdiff_t>(std::min(warnings_returned_, all.size()))};
 }
