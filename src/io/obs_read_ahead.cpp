@@ -84,7 +84,9 @@ ObsReadAhead& ObsReadAhead::operator=(ObsReadAhead&& other) noexcept {
   return *this;
 }
 
-ObsReadAhead::~ObsReadAhead() { stop(); }
+ObsReadAhead::~ObsReadAhead() {
+  stop();
+}
 
 void ObsReadAhead::stop() {
   if (!shared_) return;
