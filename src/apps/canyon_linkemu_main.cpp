@@ -9,14 +9,6 @@
 // --stats FILE gets the counters as one JSON object every second. SIGINT/SIGTERM release every held packet and stop.
 // Exit codes: 0 stopped by a signal, 1 runtime failure (no NFQUEUE: not root or no kernel support), 2 bad options.
 
-#include <arpa/inet.h>
-#include <libnetfilter_queue/libnetfilter_queue.h>
-#include <linux/netfilter.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -30,6 +22,13 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <arpa/inet.h>
+#include <libnetfilter_queue/libnetfilter_queue.h>
+#include <linux/netfilter.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "canyon/netemu/link_model.hpp"
 
@@ -42,8 +41,12 @@ constexpr std::uint32_t kDuplicateMark = 0x77;
 volatile std::sig_atomic_t g_stop = 0;
 volatile std::sig_atomic_t g_reload = 0;
 
-extern "C" void on_stop(int /*signal*/) { g_stop = 1; }
-extern "C" void on_hup(int /*signal*/) { g_reload = 1; }
+extern "C" void on_stop(int /*signal*/) {
+  g_stop = 1;
+}
+extern "C" void on_hup(int /*signal*/) {
+  g_reload = 1;
+}
 
 std::int64_t now_ns() {
   timespec ts{};
@@ -186,8 +189,9 @@ canyon::Result<canyon::netemu::LinkOptions> load_options(const std::string& conf
 }
 
 int run(int argc, char** argv) {
-  CLI::App cli{"canyon-linkemu: emulates a WAN link (delay, jitter, loss, bandwidth, outages, duplication, "
-               "reordering, corruption) on the packets of an NFQUEUE"};
+  CLI::App cli{
+      "canyon-linkemu: emulates a WAN link (delay, jitter, loss, bandwidth, outages, duplication, "
+      "reordering, corruption) on the packets of an NFQUEUE"};
   int queue_num = 0;
   std::string config_file;
   std::vector<std::string> sets;
@@ -196,8 +200,9 @@ int run(int argc, char** argv) {
       ->required()
       ->check(CLI::Range(0, 65535));
   cli.add_option("--config", config_file, "key=value link options, re-read on SIGHUP")->check(CLI::ExistingFile);
-  cli.add_option("--set", sets, "key=value over the file (delay_ms, jitter_ms, loss, rate_kbps, queue_limit_ms, "
-                                "duplicate, reorder, reorder_ms, corrupt, outage, seed)");
+  cli.add_option("--set", sets,
+                 "key=value over the file (delay_ms, jitter_ms, loss, rate_kbps, queue_limit_ms, "
+                 "duplicate, reorder, reorder_ms, corrupt, outage, seed)");
   cli.add_option("--stats", stats_file, "write the counters as JSON to this file every second");
   try {
     cli.parse(argc, argv);
@@ -252,8 +257,7 @@ int run(int argc, char** argv) {
   hup_action.sa_handler = on_hup;
   sigaction(SIGHUP, &hup_action, nullptr);
 
-  std::cerr << "canyon-linkemu: queue " << queue_num << ", "
-            << one_line(emu.model.options().to_text()) << "\n"
+  std::cerr << "canyon-linkemu: queue " << queue_num << ", " << one_line(emu.model.options().to_text()) << "\n"
             << std::flush;
   const int fd = nfq_fd(handle);
   std::vector<char> buffer(1U << 17U);
@@ -298,8 +302,8 @@ int run(int argc, char** argv) {
   write_stats(emu, stats_file, static_cast<double>(now_ns() - start_ns) * 1e-9);
   const auto& c = emu.model.counters();
   std::cerr << "canyon-linkemu: stopped: " << c.packets << " packets, " << c.lost << " lost, " << c.outage_drops
-            << " outage drops, " << c.queue_drops << " queue drops, " << c.duplicated << " duplicated, "
-            << c.reordered << " reordered, " << c.corrupted << " corrupted\n";
+            << " outage drops, " << c.queue_drops << " queue drops, " << c.duplicated << " duplicated, " << c.reordered
+            << " reordered, " << c.corrupted << " corrupted\n";
   if (emu.raw_fd >= 0) close(emu.raw_fd);
   nfq_destroy_queue(emu.queue);
   nfq_close(handle);

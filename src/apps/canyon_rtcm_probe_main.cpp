@@ -41,7 +41,9 @@ constexpr int kExitUsage = 2;
 constexpr int kExitRefused = 3;
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int /*signal*/) { g_stop.store(true); }
+extern "C" void on_signal(int /*signal*/) {
+  g_stop.store(true);
+}
 
 std::int64_t unix_now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -53,9 +55,9 @@ struct ReaderStats {
   std::uint64_t gaps = 0;          ///< frames missing between consecutive sequence numbers
   std::uint64_t out_of_order = 0;  ///< a sequence number lower than one already seen
   std::uint64_t duplicates = 0;
-  std::uint64_t bad = 0;           ///< not one RTCM 3 frame (from_msg refused it)
-  std::uint64_t foreign = 0;       ///< frames of another station than --station (injected)
-  std::uint64_t restarts = 0;      ///< the base started again (sequence number 0 after higher ones)
+  std::uint64_t bad = 0;       ///< not one RTCM 3 frame (from_msg refused it)
+  std::uint64_t foreign = 0;   ///< frames of another station than --station (injected)
+  std::uint64_t restarts = 0;  ///< the base started again (sequence number 0 after higher ones)
   std::int64_t first_seq = -1;
   std::int64_t last_seq = -1;
   std::int64_t newest_send_unix_ns = 0;
@@ -74,8 +76,9 @@ std::string latency_json(const std::vector<double>& v) {
   std::ostringstream out;
   out.precision(4);
   out << std::fixed << "{\"p50_ms\":" << percentile(v, 50) << ",\"p95_ms\":" << percentile(v, 95)
-      << ",\"p99_ms\":" << percentile(v, 99) << ",\"max_ms\":" << (v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()))
-      << ",\"count\":" << v.size() << "}";
+      << ",\"p99_ms\":" << percentile(v, 99)
+      << ",\"max_ms\":" << (v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())) << ",\"count\":" << v.size()
+      << "}";
   return out.str();
 }
 
@@ -149,7 +152,8 @@ int run(int argc, char** argv) {
   cli.add_option("--readers", readers, "subscribe: participants, one reader each")->check(CLI::Range(1, 256));
   cli.add_option("--station", station, "subscribe: the expected station id; frames of others count as foreign");
   cli.add_option("--duration", duration_s, "stop after this many seconds")->check(CLI::PositiveNumber);
-  cli.add_option("--idle", idle_s, "subscribe: stop this many seconds after the last frame")->check(CLI::PositiveNumber);
+  cli.add_option("--idle", idle_s, "subscribe: stop this many seconds after the last frame")
+      ->check(CLI::PositiveNumber);
   cli.add_option("--wait", wait_s, "inject: wait this long for a matched reader")->check(CLI::NonNegativeNumber);
   cli.add_option("--count", count, "inject: frames to publish")->check(CLI::Range(1, 100000));
   cli.add_option("--json-lines", json_lines, "subscribe: dashboard snapshot every second to this file ('-' stdout)");
@@ -207,46 +211,44 @@ int run(int argc, char** argv) {
       std::cerr << "canyon-rtcm-probe: " << p.error().to_string() << "\n";
       return kExitRuntime;
     }
-    auto r = canyon::pipeline::RtcmReader::create(
-        **p, topic, "rtcm_reader", [&, k](canyon::msg::RtcmFrame&& m) {
-          const std::int64_t now = unix_now_ns();
-          last_frame_ns.store(canyon::core::pipeline_now_ns());
-          auto f = canyon::pipeline::from_msg(m);
-          const std::lock_guard lock(mutex);
-          ReaderStats& s = stats[static_cast<std::size_t>(k)];
-          if (!f) {
-            ++s.bad;
-            return;
-          }
-          if (station >= 0 && f->station_id != station) {
-            ++s.foreign;
-            return;
-          }
-          ++s.received;
-          const auto seq = static_cast<std::int64_t>(f->sequence);
-          if (seq == 0 && s.last_seq > 0) {  // a new base run numbers its frames from 0 again
-            ++s.restarts;
-            s.seen.clear();
-            s.last_seq = -1;
-          }
-          if (k == 0 && arrivals_out != nullptr) {
-            *arrivals_out << canyon::core::pipeline_now_ns() << "," << seq << "," << m.send_unix_ns() << "," << now
-                          << "\n";
-          }
-          if (!s.seen.insert(f->sequence).second) {
-            ++s.duplicates;
-            return;
-          }
-          if (s.first_seq < 0) s.first_seq = seq;
-          if (seq < s.last_seq) {
-            ++s.out_of_order;
-          } else {
-            if (s.last_seq >= 0 && seq > s.last_seq + 1) s.gaps += static_cast<std::uint64_t>(seq - s.last_seq - 1);
-            s.last_seq = seq;
-          }
-          s.newest_send_unix_ns = std::max(s.newest_send_unix_ns, m.send_unix_ns());
-          s.latency_ms.push_back(static_cast<double>(now - m.send_unix_ns()) * 1e-6);
-        });
+    auto r = canyon::pipeline::RtcmReader::create(**p, topic, "rtcm_reader", [&, k](canyon::msg::RtcmFrame&& m) {
+      const std::int64_t now = unix_now_ns();
+      last_frame_ns.store(canyon::core::pipeline_now_ns());
+      auto f = canyon::pipeline::from_msg(m);
+      const std::lock_guard lock(mutex);
+      ReaderStats& s = stats[static_cast<std::size_t>(k)];
+      if (!f) {
+        ++s.bad;
+        return;
+      }
+      if (station >= 0 && f->station_id != station) {
+        ++s.foreign;
+        return;
+      }
+      ++s.received;
+      const auto seq = static_cast<std::int64_t>(f->sequence);
+      if (seq == 0 && s.last_seq > 0) {  // a new base run numbers its frames from 0 again
+        ++s.restarts;
+        s.seen.clear();
+        s.last_seq = -1;
+      }
+      if (k == 0 && arrivals_out != nullptr) {
+        *arrivals_out << canyon::core::pipeline_now_ns() << "," << seq << "," << m.send_unix_ns() << "," << now << "\n";
+      }
+      if (!s.seen.insert(f->sequence).second) {
+        ++s.duplicates;
+        return;
+      }
+      if (s.first_seq < 0) s.first_seq = seq;
+      if (seq < s.last_seq) {
+        ++s.out_of_order;
+      } else {
+        if (s.last_seq >= 0 && seq > s.last_seq + 1) s.gaps += static_cast<std::uint64_t>(seq - s.last_seq - 1);
+        s.last_seq = seq;
+      }
+      s.newest_send_unix_ns = std::max(s.newest_send_unix_ns, m.send_unix_ns());
+      s.latency_ms.push_back(static_cast<double>(now - m.send_unix_ns()) * 1e-6);
+    });
     if (!r) {
       std::cerr << "canyon-rtcm-probe: " << r.error().to_string() << "\n";
       return kExitRuntime;
@@ -279,8 +281,9 @@ int run(int argc, char** argv) {
       next_snapshot_ns += 1'000'000'000;
       const std::lock_guard lock(mutex);
       const ReaderStats& s = stats[0];
-      std::vector<double> recent(s.latency_ms.end() - std::min<std::ptrdiff_t>(200, static_cast<std::ptrdiff_t>(s.latency_ms.size())),
-                                 s.latency_ms.end());
+      std::vector<double> recent(
+          s.latency_ms.end() - std::min<std::ptrdiff_t>(200, static_cast<std::ptrdiff_t>(s.latency_ms.size())),
+          s.latency_ms.end());
       std::ostringstream line;
       line.precision(6);
       line << "{\"t_s\":" << static_cast<double>(now - start_ns) * 1e-9;
@@ -293,8 +296,8 @@ int run(int argc, char** argv) {
       line << ",\"queues\":{},\"drops\":{\"rtcm_gap\":" << s.gaps << ",\"rtcm_bad\":" << s.bad;
       if (!link_stats.empty()) {
         const std::string link = read_file(link_stats);
-        line << ",\"link_lost\":" << json_number(link, "lost") + json_number(link, "outage_drops") +
-                                         json_number(link, "queue_drops")
+        line << ",\"link_lost\":"
+             << json_number(link, "lost") + json_number(link, "outage_drops") + json_number(link, "queue_drops")
              << ",\"link_packets\":" << json_number(link, "packets");
       }
       line << "}}\n";
@@ -318,8 +321,7 @@ int run(int argc, char** argv) {
     out << (k > 0 ? "," : "") << "{\"received\":" << s.received << ",\"first_seq\":" << s.first_seq
         << ",\"last_seq\":" << s.last_seq << ",\"gaps\":" << s.gaps << ",\"out_of_order\":" << s.out_of_order
         << ",\"duplicates\":" << s.duplicates << ",\"bad\":" << s.bad << ",\"foreign\":" << s.foreign
-        << ",\"restarts\":" << s.restarts
-        << ",\"latency\":" << latency_json(s.latency_ms) << "}";
+        << ",\"restarts\":" << s.restarts << ",\"latency\":" << latency_json(s.latency_ms) << "}";
     all.insert(all.end(), s.latency_ms.begin(), s.latency_ms.end());
     min_received = std::min(min_received, s.received);
     total_gaps += s.gaps;

@@ -38,9 +38,9 @@ std::string trim(const std::string& s) {
 }  // namespace
 
 std::string LinkOptions::validate() const {
-  for (const auto& [name, v] : {std::pair{"delay_ms", delay_ms}, std::pair{"jitter_ms", jitter_ms},
-                                std::pair{"rate_kbps", rate_kbps}, std::pair{"queue_limit_ms", queue_limit_ms},
-                                std::pair{"reorder_ms", reorder_ms}}) {
+  for (const auto& [name, v] :
+       {std::pair{"delay_ms", delay_ms}, std::pair{"jitter_ms", jitter_ms}, std::pair{"rate_kbps", rate_kbps},
+        std::pair{"queue_limit_ms", queue_limit_ms}, std::pair{"reorder_ms", reorder_ms}}) {
     if (auto e = non_negative_rule(name, v); !e.empty()) return e;
   }
   for (const auto& [name, v] : {std::pair{"loss", loss}, std::pair{"duplicate", duplicate},
@@ -161,7 +161,8 @@ Verdict LinkModel::admit(std::int64_t arrival_ns, std::size_t size_bytes) {
     ++counters_.queue_drops;
     return v;
   }
-  const double tx_ns = options_.rate_kbps > 0.0 ? static_cast<double>(size_bytes) * 8.0 / options_.rate_kbps * 1e6 : 0.0;
+  const double tx_ns =
+      options_.rate_kbps > 0.0 ? static_cast<double>(size_bytes) * 8.0 / options_.rate_kbps * 1e6 : 0.0;
   link_free_ns_ = start_ns + static_cast<std::int64_t>(std::llround(tx_ns));
   const double delay_ns = (options_.delay_ms + (2.0 * u_jitter - 1.0) * options_.jitter_ms) * 1e6;
   std::int64_t release = std::max(link_free_ns_ + static_cast<std::int64_t>(std::llround(delay_ns)), last_release_ns_);

@@ -20,17 +20,17 @@
 namespace canyon::netemu {
 
 struct LinkOptions {
-  double delay_ms = 0.0;         ///< one-way delay added to every packet, ms
-  double jitter_ms = 0.0;        ///< uniform jitter of the delay, +- ms (packets stay in order)
-  double loss = 0.0;             ///< probability that a packet is lost, [0, 1]
-  double rate_kbps = 0.0;        ///< link bandwidth, kbit/s; 0: unlimited
-  double queue_limit_ms = 500.0; ///< tail drop when a packet would wait longer than this for the link, ms
-  double duplicate = 0.0;        ///< probability that a packet is delivered twice, [0, 1]
-  double reorder = 0.0;          ///< probability that a packet is held `reorder_ms` longer, [0, 1]
-  double reorder_ms = 10.0;      ///< extra delay of a reordered packet, ms
-  double corrupt = 0.0;          ///< probability that one payload byte is flipped, [0, 1]
-  bool outage = false;           ///< every packet is dropped while true
-  std::uint64_t seed = 1;        ///< random seed
+  double delay_ms = 0.0;          ///< one-way delay added to every packet, ms
+  double jitter_ms = 0.0;         ///< uniform jitter of the delay, +- ms (packets stay in order)
+  double loss = 0.0;              ///< probability that a packet is lost, [0, 1]
+  double rate_kbps = 0.0;         ///< link bandwidth, kbit/s; 0: unlimited
+  double queue_limit_ms = 500.0;  ///< tail drop when a packet would wait longer than this for the link, ms
+  double duplicate = 0.0;         ///< probability that a packet is delivered twice, [0, 1]
+  double reorder = 0.0;           ///< probability that a packet is held `reorder_ms` longer, [0, 1]
+  double reorder_ms = 10.0;       ///< extra delay of a reordered packet, ms
+  double corrupt = 0.0;           ///< probability that one payload byte is flipped, [0, 1]
+  bool outage = false;            ///< every packet is dropped while true
+  std::uint64_t seed = 1;         ///< random seed
 
   /// Empty when valid, else the broken rule, e.g. "loss must be in [0, 1] (is 1.5)".
   [[nodiscard]] std::string validate() const;
@@ -46,15 +46,15 @@ Result<LinkOptions> parse_link_options(const std::string& text, const std::strin
 
 /// What happens to one packet.
 struct Verdict {
-  bool drop = false;           ///< true: never delivered
-  bool outage = false;         ///< dropped because of an outage
-  bool queue_full = false;     ///< dropped by the tail-drop limit
-  bool duplicate = false;      ///< deliver a second copy at `release_ns`
-  bool reordered = false;      ///< held `reorder_ms` longer than the packets around it
-  bool corrupt = false;        ///< flip byte `corrupt_offset` (counted from the start of the payload) with `corrupt_mask`
+  bool drop = false;        ///< true: never delivered
+  bool outage = false;      ///< dropped because of an outage
+  bool queue_full = false;  ///< dropped by the tail-drop limit
+  bool duplicate = false;   ///< deliver a second copy at `release_ns`
+  bool reordered = false;   ///< held `reorder_ms` longer than the packets around it
+  bool corrupt = false;     ///< flip byte `corrupt_offset` (counted from the start of the payload) with `corrupt_mask`
   std::uint32_t corrupt_offset = 0;
   std::uint8_t corrupt_mask = 0;
-  std::int64_t release_ns = 0; ///< when to deliver (same clock as the arrival time)
+  std::int64_t release_ns = 0;  ///< when to deliver (same clock as the arrival time)
 };
 
 /// Counters of a link since start.
