@@ -10,6 +10,11 @@ emulated 20 km link. Every scenario prints one JSON object per result and exits 
   netns_suite.py faults [--short] [--secure]
         the fault suite: 20 % loss, outage, base killed and restarted, duplicated/reordered/corrupted packets, each
         with its recovery time; --short is the CI variant (seconds instead of minutes)
+  netns_suite.py live --json-lines FILE [--seconds S] [--secure]
+        real dashboard data: canyon-base replays matrtklib-static in real time, a subscriber in cy-rover writes a
+        snapshot per second (correction age, transport latency, link loss from the emulator's counters) to FILE;
+        every 40 s the link has 20 % loss for 10 s and then a 10 s outage. Serve it with
+        `canyon-dashboard --input FILE --follow`
   netns_suite.py short
         what ctest runs: relay (4 subscribers), security, faults --short
 
@@ -349,6 +354,23 @@ def faults(args, tmp):
     return ok
 
 
+def live(args, tmp):
+    with Setup(tmp, secure=args.secure) as s:
+        probe = s.probe("live", readers=1, idle=30.0, duration=args.seconds,
+                        extra=["--json-lines", os.path.abspath(args.json_lines), "--link-stats",
+                               os.path.join(STATE, "stats-cy-base.json")])
+        s.base("base", dataset="matrtklib-static", pace=1.0, wait_clients=1)
+        start = time.monotonic()
+        while probe.poll() is None and time.monotonic() - start < args.seconds + 5:
+            phase = (time.monotonic() - start) % 40.0
+            want = ["loss=0.2"] if 10 <= phase < 20 else (["outage=1"] if 20 <= phase < 30 else ["loss=0.01", "outage=0"])
+            twohost("set", *want)
+            time.sleep(1.0)
+        wait(probe, 60, "canyon-rtcm-probe")
+    print(json.dumps({"scenario": "live", "json_lines": args.json_lines, "ok": True}), flush=True)
+    return True
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="cmd", required=True)
@@ -363,6 +385,10 @@ def main():
     f = sub.add_parser("faults")
     f.add_argument("--short", action="store_true")
     f.add_argument("--secure", action="store_true")
+    lv = sub.add_parser("live")
+    lv.add_argument("--json-lines", required=True)
+    lv.add_argument("--seconds", type=float, default=120.0)
+    lv.add_argument("--secure", action="store_true")
     sub.add_parser("short")
     args = parser.parse_args()
     why = check_environment()
@@ -377,6 +403,8 @@ def main():
             ok = security(args, tmp)
         elif args.cmd == "faults":
             ok = faults(args, tmp)
+        elif args.cmd == "live":
+            ok = live(args, tmp)
         else:
             ok = relay(argparse.Namespace(subscribers=4, secure=False, profile="wan-initial-peers", pace=5.0,
                                           link=LINK_20KM), tmp)
