@@ -9,7 +9,7 @@
 //   inject:    publishes --count forged but valid RTCM 3 frames (station 4095) at 10 Hz: the security tests show
 //              that a participant without valid credentials or permissions reaches no subscriber.
 // Exit codes: 0 done, 1 runtime failure (DDS entities not created), 2 bad command line, 3 inject: the writer was
-// refused (access control).
+// refused (access control), 4 subscribe: no frame arrived (the summary is printed all the same).
 
 #include <algorithm>
 #include <atomic>
@@ -39,6 +39,7 @@ namespace {
 constexpr int kExitRuntime = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitRefused = 3;
+constexpr int kExitNothing = 4;
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int /*signal*/) {
@@ -334,6 +335,11 @@ int run(int argc, char** argv) {
       << ",\"duplicates\":" << total_dup << ",\"bad\":" << total_bad << ",\"foreign\":" << total_foreign
       << ",\"latency\":" << latency_json(all) << "}\n";
   std::cout << out.str();
+  if (all.empty()) {
+    std::cerr << "canyon-rtcm-probe: no frame received on '" << topic << "' (domain " << domain
+              << "): no base matched (link down, wrong domain, profile or topic, or refused by DDS-Security)\n";
+    return kExitNothing;
+  }
   return 0;
 }
 

@@ -8,6 +8,7 @@
 
 #include <httplib.h>
 #include <nlohmann/json.hpp>
+#include <sys/socket.h>
 
 namespace canyon::dashboard {
 namespace {
@@ -164,6 +165,12 @@ Result<std::unique_ptr<DashboardServer>> DashboardServer::start(const ServerOpti
   if (const std::string e = options.validate(); !e.empty()) return Error{"dashboard: " + e};
   std::unique_ptr<DashboardServer> s(new DashboardServer(options));
   s->routes();
+  // SO_REUSEADDR only: httplib's default also sets SO_REUSEPORT, with which a second dashboard on the same port
+  // would silently share it instead of failing.
+  s->http_->set_socket_options([](int sock) {
+    const int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   const int port = options.port == 0 ? s->http_->bind_to_any_port(options.host)
                                      : (s->http_->bind_to_port(options.host, options.port) ? options.port : -1);
   if (port <= 0) {
@@ -173,6 +180,8 @@ Result<std::unique_ptr<DashboardServer>> DashboardServer::start(const ServerOpti
   s->port_ = port;
   DashboardServer* raw = s.get();
   s->thread_ = std::thread([raw] { raw->http_->listen_after_bind(); });
+  // Running before returning: a stop() that came before the accept loop started would be missed (and join hang).
+  for (int i = 0; i < 500 && !s->http_->is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   return s;
 }
 
