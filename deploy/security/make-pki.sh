@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# shellcheck disable=SC2034 # the rules_* variables are read through ${!rules} in make_domain
 # DDS-Security material for canyon (Fast DDS builtin plugins: PKI-DH authentication, Access-Permissions, AES-GCM-GMAC):
 # a test identity CA and permissions CA, one identity per role, the governance and permissions documents signed by
 # the permissions CA, and secure variants of deploy/dds/*.xml for each role.
@@ -155,7 +156,7 @@ secure_profile() { # SRC DST CA_DIR ROLE_DIR GOVERNANCE
     /<participant / { in_participant = 1 }
     in_participant && /<\/rtps>/ && !done { print props; done = 1 }
     { print }
-  ' "$1" | sed 's|<!-- \(LAN\|WAN\)|<!-- SECURE (DDS-Security, deploy/security/make-pki.sh). \1|' > "$2"
+  ' "$1" | sed 's#<!-- \(LAN\|WAN\)#<!-- SECURE (DDS-Security, deploy/security/make-pki.sh). \1#' > "$2"
 }
 
 # make_pki CA_DIR ROLES...: the CAs, governance and the roles' identities, permissions and profiles.
