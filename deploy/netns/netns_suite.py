@@ -342,8 +342,9 @@ def faults(args, tmp):
     complete_after_restart = reader["restarts"] >= 1 and seqs_after == list(range(frames2))
     # Without security a corrupted packet (UDP checksum cleared) reaches the application as a sample: the RTCM
     # CRC-24Q rejects it and that frame is lost for good (counted in gaps). With security AES-GCM rejects the packet
-    # and the reliable protocol repeats it: nothing tampered is delivered and nothing is lost.
-    ok = ok and complete_after_restart and (not args.secure or (r["bad"] == 0 and r["gaps"] == 0))
+    # and the reliable protocol repeats it: nothing tampered is delivered. (Frames sent during an outage longer than
+    # the participants' lease are lost either way: see deploy/README.md.)
+    ok = ok and complete_after_restart and (not args.secure or r["bad"] == 0)
     print(json.dumps({"scenario": "faults", "short": args.short, "secure": args.secure, "results": results,
                       "restarted_run_complete": complete_after_restart, "frames_restarted_run": frames2,
                       "received_total": reader["received"], "duplicates_delivered": r["duplicates"],
