@@ -12,6 +12,9 @@ packages=(
   clang-format clang-tidy clang-14 libclang-rt-14-dev
   rtklib
   libxml2-utils
+  # deployment (issue 8): link emulator, namespaces, DDS-Security test PKI, dashboard server and its browser test
+  libnetfilter-queue-dev iptables iproute2 iputils-ping openssl python3
+  libcpp-httplib-dev nlohmann-json3-dev chromium nodejs
 )
 
 # One dpkg-query call for all packages; a package dpkg has never heard of prints nothing and counts as missing.
@@ -25,6 +28,11 @@ done
 # fastddsgen is a Java program: apt pulls in a runtime with it, but make sure `java` is there in any case.
 if ! command -v java > /dev/null 2>&1; then
   missing+=(default-jre-headless)
+fi
+
+# The dashboard page is bundled with npm: Debian's npm package, unless a node installation brings its own npm.
+if ! command -v npm > /dev/null 2>&1; then
+  missing+=(npm)
 fi
 
 if ((${#missing[@]} == 0)); then
