@@ -12,6 +12,7 @@ packages=(
   clang-format clang-tidy clang-14 libclang-rt-14-dev
   rtklib
   libxml2-utils
+  libreaderwriterqueue-dev
 )
 
 # One dpkg-query call for all packages; a package dpkg has never heard of prints nothing and counts as missing.
