@@ -52,7 +52,12 @@ Result<ObservationStream> ObservationStream::open(const std::string& path, const
   stream.rtcm_total_ = stream.rtcm_epochs_.size();
   if (const auto& station = decoder.rtcm3().station())
     stream.rtcm_header_.receiver.approx_position_E_m = station->arp_E_m;
-  for (const std::string& p : decoder.problems()) stream.rtcm_warnings_.push_back(path + ": " + p);
+  for (const std::string& p : decoder.problems()) {
+    std::string warning = path;
+    warning += ": ";
+    warning += p;
+    stream.rtcm_warnings_.push_back(std::move(warning));
+  }
   return stream;
 }
 

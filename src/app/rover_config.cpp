@@ -30,11 +30,9 @@ bool operator==(const RoverConfig& a, const RoverConfig& b) {
 Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string& file) {
   RoverConfig c;
   YamlMap top(node, file);
-  if (!top.has("estimator"))
-    return Error{
-        "'estimator:' (the canyon process keys: mode, rover, base, nav, ...) is "
-        "required",
-        file, 0};
+  if (!top.has("estimator")) {
+    return Error{"'estimator:' (the canyon process keys: mode, rover, base, nav, ...) is required", file, 0};
+  }
   (void)top.sub("estimator");
   auto estimator = parse_process_config(node["estimator"], file);
   if (!estimator) return estimator.error();

@@ -8,7 +8,8 @@
 #   memory      the rover's resident memory, sampled every 0.5 s, over a long replay
 # Usage: tests/bench/rover_bench.sh {throughput|latency|scale|memory|all} [BUILD_DIR] [WORK_DIR]
 #   env: THROUGHPUT_S (600 s of data), LATENCY_S (120), SCALE_S (120), ROVERS (16), SUBSCRIBERS (4), MEMORY_S (1800),
-#        MEMORY_PACE (0: as fast as possible), DOMAIN (default 150 + PID % 80)
+#        MEMORY_PACE (0: as fast as possible), DOMAIN (default 150 + PID % 80), PIPELINE_THREADED (true; false runs
+#        the rovers' stages on one thread)
 set -uo pipefail
 
 what="${1:-all}"
@@ -51,7 +52,7 @@ rover_yaml() {
   echo "  base_position: [$(header_position "${sim}/base.obs")]"
   echo "rover_id: $5"
   echo "input: {pace: $4, base: $3, base_wait_s: 5}"
-  echo "pipeline: {threaded: true, queue_capacity: 64}"
+  echo "pipeline: {threaded: ${PIPELINE_THREADED:-true}, queue_capacity: 64}"
   echo "dds: {domain: ${domain}, profiles: ${profiles}}"
 }
 
