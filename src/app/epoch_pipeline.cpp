@@ -10,6 +10,21 @@
 #include "canyon/core/time.hpp"
 
 namespace canyon::app {
+namespace {
+
+void copy_filter(const rtk::RtkEpoch& epoch, EpochOutput& out) {
+  out.has_float = epoch.num_dd_measurements > 0;
+  out.float_p_E_m = epoch.float_p_E_m;
+  out.float_P_E_m2 = epoch.float_P_E_m2;
+  out.dd_phase_rows = epoch.num_dd_measurements;
+  out.dd_code_rows = epoch.num_dd_code_measurements;
+  out.max_post_fit_normalised = epoch.max_post_fit_normalised;
+  out.has_prior = epoch.aided;
+  out.prior_p_E_m = epoch.prior_p_E_m;
+  out.prior_P_E_m2 = epoch.prior_P_E_m2;
+}
+
+}  // namespace
 
 const char* stage_name(Stage stage) {
   switch (stage) {
@@ -48,6 +63,7 @@ void RtkEstimator::resolve(EpochItem& item) {
   if (item.to_resolve) engine_.resolve();
   rtk::RtkEpoch epoch = engine_.take_epoch();
   EpochOutput out;
+  copy_filter(epoch, out);
   out.solution = epoch.solution;
   out.hdop = epoch.hdop;
   out.note = std::move(epoch.note);
@@ -83,6 +99,7 @@ void FusionEstimator::resolve(EpochItem& item) {
   if (item.to_resolve) engine_.resolve();
   fusion::FusionEpoch epoch = engine_.finish_epoch();
   EpochOutput out;
+  copy_filter(epoch.rtk, out);
   out.solution = epoch.solution;
   out.hdop = epoch.hdop;
   out.note = std::move(epoch.note);

@@ -202,13 +202,28 @@ int run(int argc, char** argv) {
     return kExitRuntime;
   }
   std::unique_ptr<pl::BridgedWriter> bridged_writer;
-  if (config->publish_stages && est.mode == app::ProcessMode::Fusion) {
-    auto w = pl::BridgedWriter::create(**participant, "canyon/bridged", "stage_writer");
-    if (!w) {
-      spdlog::error("{}", w.error().to_string());
+  std::unique_ptr<pl::AlignmentWriter> alignment_writer;
+  std::unique_ptr<pl::PriorWriter> prior_writer;
+  std::unique_ptr<pl::FloatWriter> float_writer;
+  if (config->publish_stages) {
+    auto p = pl::PriorWriter::create(**participant, "canyon/prior", "stage_writer");
+    auto f = pl::FloatWriter::create(**participant, "canyon/float", "stage_writer");
+    if (!p || !f) {
+      spdlog::error("{}", (!p ? p.error() : f.error()).to_string());
       return kExitRuntime;
     }
-    bridged_writer = std::move(*w);
+    prior_writer = std::move(*p);
+    float_writer = std::move(*f);
+    if (est.mode == app::ProcessMode::Fusion) {
+      auto b = pl::BridgedWriter::create(**participant, "canyon/bridged", "stage_writer");
+      auto a = pl::AlignmentWriter::create(**participant, "canyon/alignment", "stage_writer");
+      if (!b || !a) {
+        spdlog::error("{}", (!b ? b.error() : a.error()).to_string());
+        return kExitRuntime;
+      }
+      bridged_writer = std::move(*b);
+      alignment_writer = std::move(*a);
+    }
   }
 
   // Base frames: the DDS listener only queues them (dropped and counted when the queue is full).
@@ -304,7 +319,8 @@ int run(int argc, char** argv) {
 
   RoverSource source(std::move(*rover), config->pace, std::move(file_base), dds_base ? &base_frames : nullptr,
                      config->base_wait_s);
-  std::uint64_t solved = 0, fixed = 0, epochs = 0, refused = 0;
+  std::uint64_t solved = 0, fixed = 0, epochs = 0;
+  std::atomic<std::uint64_t> refused{0};  // the time bridge's and the ambiguity stage's threads publish
   const auto sink = [&](const app::EpochItem& item) -> Status {
     ++epochs;
     if (item.output) {
@@ -320,7 +336,7 @@ int run(int argc, char** argv) {
   const auto observer = [&](app::Stage stage, const app::EpochItem& item) {
     if (stage == app::Stage::TimeBridge && bridged_writer) {
       auto m = pl::to_msg_bridged(item);
-      bridged_writer->write(m);
+      if (!bridged_writer->write(m)) ++refused;
     }
     if (stage != app::Stage::Ambiguity) return;
     context.base_late = source.base_late();
@@ -334,6 +350,16 @@ int run(int argc, char** argv) {
       context.alignment_rmse_m = item.output->alignment->rmse_m;
       context.alignment_eigen_ratio = item.output->alignment->first_eigenvalue_ratio;
       context.lever_arm_m = item.output->alignment->t_IA_m;
+    }
+    if (prior_writer) {
+      auto prior = pl::to_msg_prior(item);
+      if (!prior_writer->write(prior)) ++refused;
+      auto floating = pl::to_msg_float(item);
+      if (!float_writer->write(floating)) ++refused;
+    }
+    if (alignment_writer) {
+      auto alignment = pl::to_msg_alignment(item);
+      if (!alignment_writer->write(alignment)) ++refused;
     }
     auto solution = pl::to_msg_solution(item, context);
     if (!(*solution_writer)->write(solution)) ++refused;
@@ -372,7 +398,7 @@ int run(int argc, char** argv) {
   if (!(*solution_writer)->wait_for_acknowledgments(5.0) || !(*timing_writer)->wait_for_acknowledgments(5.0)) {
     spdlog::warn("DDS: not every solution was acknowledged by every reader within 5 s");
   }
-  if (refused > 0) spdlog::warn("DDS: {} samples refused by the writers (history full)", refused);
+  if (refused.load() > 0) spdlog::warn("DDS: {} samples refused by the writers (history full)", refused.load());
   if (base_frames_dropped.load() > 0 || base_frames_bad.load() > 0) {
     spdlog::warn("base: {} RTCM frames dropped (queue full), {} malformed", base_frames_dropped.load(),
                  base_frames_bad.load());

@@ -78,7 +78,10 @@ int run(int argc, char** argv) {
   std::string solution_topic = "canyon/solution";
   std::string timing_topic = "canyon/timing";
   if (kTool != "monitor") {
-    cli.add_option("topic", topic, "canyon/solution, canyon/timing, canyon/rtcm or canyon/bridged")->required();
+    cli.add_option("topic", topic,
+                   "canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior or "
+                   "canyon/float")
+        ->required();
   } else {
     cli.add_option("--solution-topic", solution_topic, "Solution topic");
     cli.add_option("--timing-topic", timing_topic, "Stage timing topic");
@@ -101,11 +104,14 @@ int run(int argc, char** argv) {
     return code == 0 ? 0 : kExitUsage;
   }
   if (kTool != "monitor") {
-    const bool known = topic == "canyon/solution" || topic == "canyon/timing" || topic == "canyon/rtcm" ||
-                       topic == "canyon/bridged" || ends_with(topic, "solution") || ends_with(topic, "timing") ||
-                       ends_with(topic, "rtcm");
+    bool known = false;
+    for (const char* suffix : {"solution", "timing", "rtcm", "bridged", "prior", "float", "alignment"}) {
+      known = known || ends_with(topic, suffix);
+    }
     if (!known) {
-      return fail("unknown topic '" + topic + "': canyon/solution, canyon/timing, canyon/rtcm or canyon/bridged",
+      return fail("unknown topic '" + topic +
+                      "': canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior "
+                      "or canyon/float",
                   kExitUsage);
     }
   }
@@ -153,6 +159,9 @@ int run(int argc, char** argv) {
   std::unique_ptr<pl::TimingReader> timing_reader;
   std::unique_ptr<pl::RtcmReader> rtcm_reader;
   std::unique_ptr<pl::BridgedReader> bridged_reader;
+  std::unique_ptr<pl::PriorReader> prior_reader;
+  std::unique_ptr<pl::FloatReader> float_reader;
+  std::unique_ptr<pl::AlignmentReader> alignment_reader;
   const auto on_solution = [&](canyon::msg::Solution&& m) {
     const std::int64_t now = canyon::core::pipeline_now_ns();
     const std::lock_guard lock(mutex);
@@ -235,19 +244,40 @@ int run(int argc, char** argv) {
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     rtcm_reader = std::move(*r);
   }
+  // Stage outputs: one line of text per sample (echo) or per record line (record).
+  const auto text_sample = [&](const std::string& line) {
+    const std::lock_guard lock(mutex);
+    count_one();
+    if (kTool == "echo") {
+      std::printf("%s\n", line.c_str());
+      std::fflush(stdout);
+    } else {
+      raw << line << '\n';
+    }
+  };
   if (kTool != "monitor" && ends_with(topic, "bridged")) {
-    auto r = pl::BridgedReader::create(**participant, topic, "stage_reader", [&](canyon::msg::BridgedEpoch&& m) {
-      const std::lock_guard lock(mutex);
-      count_one();
-      if (kTool == "echo") {
-        std::printf("%s\n", pl::describe(m).c_str());
-        std::fflush(stdout);
-      } else {
-        raw << pl::describe(m) << '\n';
-      }
-    });
+    auto r = pl::BridgedReader::create(**participant, topic, "stage_reader",
+                                       [&](canyon::msg::BridgedEpoch&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     bridged_reader = std::move(*r);
+  }
+  if (kTool != "monitor" && ends_with(topic, "prior")) {
+    auto r = pl::PriorReader::create(**participant, topic, "stage_reader",
+                                     [&](canyon::msg::Prior&& m) { text_sample(pl::describe(m)); });
+    if (!r) return fail(r.error().to_string(), kExitRuntime);
+    prior_reader = std::move(*r);
+  }
+  if (kTool != "monitor" && ends_with(topic, "float")) {
+    auto r = pl::FloatReader::create(**participant, topic, "stage_reader",
+                                     [&](canyon::msg::FloatSolution&& m) { text_sample(pl::describe(m)); });
+    if (!r) return fail(r.error().to_string(), kExitRuntime);
+    float_reader = std::move(*r);
+  }
+  if (kTool != "monitor" && ends_with(topic, "alignment")) {
+    auto r = pl::AlignmentReader::create(**participant, topic, "stage_reader",
+                                         [&](canyon::msg::Alignment&& m) { text_sample(pl::describe(m)); });
+    if (!r) return fail(r.error().to_string(), kExitRuntime);
+    alignment_reader = std::move(*r);
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -258,6 +288,9 @@ int run(int argc, char** argv) {
     if (timing_reader) n += timing_reader->matched();
     if (rtcm_reader) n += rtcm_reader->matched();
     if (bridged_reader) n += bridged_reader->matched();
+    if (prior_reader) n += prior_reader->matched();
+    if (float_reader) n += float_reader->matched();
+    if (alignment_reader) n += alignment_reader->matched();
     return n;
   };
   const auto start = std::chrono::steady_clock::now();
@@ -292,6 +325,9 @@ int run(int argc, char** argv) {
   timing_reader.reset();
   rtcm_reader.reset();
   bridged_reader.reset();
+  prior_reader.reset();
+  float_reader.reset();
+  alignment_reader.reset();
   if (kTool == "monitor") report();
   if (pos) {
     if (auto c = pos->close(); !c && error.empty()) error = c.error().to_string();

@@ -316,6 +316,7 @@ FusionEpoch FusionEngine::finish_epoch() {
   if (out.solution.status == core::SolutionStatus::Fixed) ++stats_.fixed;
   out.rejected = result->rejected;
   out.ar_pruned = result->ar_pruned;
+  out.rtk = epoch;
 
   // Remember the solution with its VIO pose for the alignment windows, and for the constant-velocity prediction.
   const std::optional<VioPoseAt>& pose = epoch_pose_;

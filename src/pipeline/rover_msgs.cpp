@@ -130,6 +130,84 @@ msg::BridgedEpoch to_msg_bridged(const app::EpochItem& item) {
   return m;
 }
 
+msg::Prior to_msg_prior(const app::EpochItem& item) {
+  msg::Prior m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  if (item.output && item.output->has_prior) {
+    const app::EpochOutput& o = *item.output;
+    m.aided(true);
+    m.p_E_m({o.prior_p_E_m.x(), o.prior_p_E_m.y(), o.prior_p_E_m.z()});
+    m.covariance_E_m2(upper(o.prior_P_E_m2));
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+msg::FloatSolution to_msg_float(const app::EpochItem& item) {
+  msg::FloatSolution m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  if (item.output && item.output->has_float) {
+    const app::EpochOutput& o = *item.output;
+    m.valid(true);
+    m.p_E_m({o.float_p_E_m.x(), o.float_p_E_m.y(), o.float_p_E_m.z()});
+    m.covariance_E_m2(upper(o.float_P_E_m2));
+    m.dd_phase_rows(o.dd_phase_rows);
+    m.dd_code_rows(o.dd_code_rows);
+    m.max_post_fit_normalised(o.max_post_fit_normalised);
+    m.rejected(satellite_names(o.rejected));
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+msg::Alignment to_msg_alignment(const app::EpochItem& item) {
+  msg::Alignment m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  m.kind("none");
+  if (item.output && item.output->alignment) {
+    const app::EpochOutput::Alignment& a = *item.output->alignment;
+    m.aligned(true);
+    m.kind(a.kind.substr(0, 15));
+    m.rmse_m(a.rmse_m);
+    m.first_eigenvalue_ratio(a.first_eigenvalue_ratio);
+    m.t_IA_m({a.t_IA_m.x(), a.t_IA_m.y(), a.t_IA_m.z()});
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+std::string describe(const msg::Prior& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "prior #%llu %d %.3f %s p_E [%.3f %.3f %.3f] sigma %.3f m",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(),
+                m.aided() ? "aided" : "not-aided", m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2],
+                std::sqrt(std::max(0.0, m.covariance_E_m2()[0] + m.covariance_E_m2()[3] + m.covariance_E_m2()[5])));
+  return line;
+}
+
+std::string describe(const msg::FloatSolution& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "float #%llu %d %.3f %s p_E [%.3f %.3f %.3f] DD phase %d code %d post-fit %.2f",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(),
+                m.valid() ? "valid" : "none", m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2], m.dd_phase_rows(),
+                m.dd_code_rows(), m.max_post_fit_normalised());
+  return line;
+}
+
+std::string describe(const msg::Alignment& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "alignment #%llu %d %.3f %s RMSE %.3f m FER %.3f t_IA [%.3f %.3f %.3f] m",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(), m.kind().c_str(),
+                m.rmse_m(), m.first_eigenvalue_ratio(), m.t_IA_m()[0], m.t_IA_m()[1], m.t_IA_m()[2]);
+  return line;
+}
+
 Result<core::Solution> from_msg(const msg::Solution& m) {
   const std::string which = "Solution " + std::to_string(m.sequence_number());
   const int status = m.status();

@@ -56,6 +56,16 @@ struct EpochOutput {
   std::vector<core::SatelliteId> rejected;
   std::vector<core::SatelliteId> ar_pruned;
   bool aided = false;
+  /// The update stage's float solution and the prediction's prior (aided epochs), from the RTK engine.
+  bool has_float = false;
+  Eigen::Vector3d float_p_E_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d float_P_E_m2 = Eigen::Matrix3d::Zero();
+  int dd_phase_rows = 0;
+  int dd_code_rows = 0;
+  double max_post_fit_normalised = 0.0;
+  bool has_prior = false;
+  Eigen::Vector3d prior_p_E_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d prior_P_E_m2 = Eigen::Matrix3d::Zero();
   /// Fusion: the last accepted alignment (RMSE, first eigenvalue ratio) and the lever arm in use.
   struct Alignment {
     std::string kind;

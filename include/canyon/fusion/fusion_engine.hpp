@@ -106,6 +106,7 @@ struct FusionEpoch {
   std::string note;                          ///< why the epoch is not fixed
   std::vector<core::SatelliteId> rejected;   ///< satellites gated out of the update (innovation, post-fit)
   std::vector<core::SatelliteId> ar_pruned;  ///< satellites pruned by the ambiguity resolution
+  rtk::RtkEpoch rtk;                         ///< the RTK engine's epoch (float solution, prior, DD rows)
 };
 
 struct AlignmentEvent {

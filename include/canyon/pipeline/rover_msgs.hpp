@@ -35,6 +35,11 @@ struct EpochContext {
 [[nodiscard]] msg::Solution to_msg_solution(const app::EpochItem& item, const EpochContext& context);
 [[nodiscard]] msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& context);
 [[nodiscard]] msg::BridgedEpoch to_msg_bridged(const app::EpochItem& item);
+/// The prediction's prior, the update's float solution and the alignment in use, of an epoch that left the last
+/// stage (the engines hand them over with the epoch's result).
+[[nodiscard]] msg::Prior to_msg_prior(const app::EpochItem& item);
+[[nodiscard]] msg::FloatSolution to_msg_float(const app::EpochItem& item);
+[[nodiscard]] msg::Alignment to_msg_alignment(const app::EpochItem& item);
 
 /// The solution for a .pos/NMEA writer; Error if the message is malformed (bad status, sizes, non-finite values).
 Result<core::Solution> from_msg(const msg::Solution& m);
@@ -47,10 +52,19 @@ using TimingWriter = DdsWriter<msg::StageTiming, msg::StageTimingPubSubType>;
 using TimingReader = DdsReader<msg::StageTiming, msg::StageTimingPubSubType>;
 using BridgedWriter = DdsWriter<msg::BridgedEpoch, msg::BridgedEpochPubSubType>;
 using BridgedReader = DdsReader<msg::BridgedEpoch, msg::BridgedEpochPubSubType>;
+using PriorWriter = DdsWriter<msg::Prior, msg::PriorPubSubType>;
+using PriorReader = DdsReader<msg::Prior, msg::PriorPubSubType>;
+using FloatWriter = DdsWriter<msg::FloatSolution, msg::FloatSolutionPubSubType>;
+using FloatReader = DdsReader<msg::FloatSolution, msg::FloatSolutionPubSubType>;
+using AlignmentWriter = DdsWriter<msg::Alignment, msg::AlignmentPubSubType>;
+using AlignmentReader = DdsReader<msg::Alignment, msg::AlignmentPubSubType>;
 
 /// One line of text per message (canyon echo).
 [[nodiscard]] std::string describe(const msg::Solution& m);
 [[nodiscard]] std::string describe(const msg::StageTiming& m);
 [[nodiscard]] std::string describe(const msg::BridgedEpoch& m);
+[[nodiscard]] std::string describe(const msg::Prior& m);
+[[nodiscard]] std::string describe(const msg::FloatSolution& m);
+[[nodiscard]] std::string describe(const msg::Alignment& m);
 
 }  // namespace canyon::pipeline
