@@ -32,7 +32,6 @@ namespace {
 constexpr int kExitRuntime = 1;
 constexpr int kExitUsage = 2;
 
-using canyon::Error;
 using canyon::Result;
 using canyon::Status;
 namespace app = canyon::app;

@@ -35,7 +35,7 @@ std::string slurp(const fs::path& path) {
 }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("canyon_test_" + name);
+  fs::path dir = fs::temp_directory_path() / ("canyon_test_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

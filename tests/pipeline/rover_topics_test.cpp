@@ -177,9 +177,7 @@ TEST(MonitorModel, JsonLineCarriesTheSchema) {
   const std::string j = model.json_line(2'000'000'000);
   for (const char* key :
        {"\"t_s\":2.000", "\"stages\":{\"ingest\":{\"p50_us\":0.5", "\"end_to_end\":{\"p50_us\":6.5",
-        "\"correction_age_s\":0.200", "\"queues\":{",
-        "\"drops\":{\"vio\":0,\"base_late\":0,"
-        "\"solutions\":2}",
+        "\"correction_age_s\":0.200", "\"queues\":{", R"("drops":{"vio":0,"base_late":0,"solutions":2})",
         "\"pruned\":[\"G05\"]", "\"alignment\":{\"rmse_m\":0.0200", "\"lever_arm_m\":[0.0000,0.0000,0.0000]"}) {
     EXPECT_NE(j.find(key), std::string::npos) << key << " not in " << j;
   }
