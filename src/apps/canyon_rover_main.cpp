@@ -406,6 +406,9 @@ int run(int argc, char** argv) {
     spdlog::warn("base: {} epochs went on without waiting longer for their base epoch (input.base_wait_s {})",
                  source.base_late(), config->base_wait_s);
   }
+  if (fusion_engine) {
+    for (const std::string& line : fusion_engine->report()) spdlog::info("{}", line);
+  }
   const app::PipelineStats stats = pipeline.stats();
   std::uint64_t waits = 0;
   for (const auto w : stats.full_waits) waits += w;
