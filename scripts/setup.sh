@@ -12,6 +12,7 @@ packages=(
   clang-format clang-tidy clang-14 libclang-rt-14-dev
   rtklib
   libxml2-utils
+  libreaderwriterqueue-dev
   # deployment (issue 8): link emulator, namespaces, DDS-Security test PKI, dashboard server and its browser test
   libnetfilter-queue-dev iptables iproute2 iputils-ping openssl python3
   libcpp-httplib-dev nlohmann-json3-dev chromium nodejs

@@ -3,9 +3,11 @@
 #include "canyon/app/process.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 
+#include "canyon/app/observation_stream.hpp"
 #include "canyon/core/geodesy.hpp"
 #include "canyon/fusion/fusion_engine.hpp"
 #include "canyon/fusion/time_bridge.hpp"
@@ -23,107 +25,6 @@ namespace canyon::app {
 namespace {
 
 constexpr std::size_t kMaxEpochNotes = 100;
-
-/// An observation file read epoch by epoch as observations: flag 6 epochs hold cycle-slip records (slip counts in
-/// the observation fields), not observations, and are dropped; after a power failure (flag 1) every phase may have
-/// slipped and gets the loss-of-lock bit. Streaming keeps memory flat however long the file is; the file is parsed
-/// ahead on a thread of its own (io::ObsReadAhead), which changes nothing but the wall time.
-class ObservationStream {
- public:
-  static Result<ObservationStream> open(const std::string& path, const io::ObsFilter& filter) {
-    auto reader = io::ObsReadAhead::open(path, filter);
-    if (!reader) return reader.error();
-    return ObservationStream(std::move(*reader), path);
-  }
-
-  /// The next epoch of observations; nullopt at the end of the file.
-  Result<std::optional<core::ObsEpoch>> next() {
-    for (;;) {
-      auto epoch = reader_.next();
-      if (!epoch) return epoch.error();
-      if (!*epoch) return std::optional<core::ObsEpoch>{};
-      core::ObsEpoch& e = **epoch;
-      if (e.flag == core::EpochFlag::CycleSlipRecords) {
-        ++slip_records_;
-        continue;
-      }
-      if (e.flag == core::EpochFlag::PowerFailure) {
-        ++power_failures_;
-        for (core::SatelliteObs& sat : e.sats) {
-          for (core::SignalObs& signal : sat.signals) signal.lli |= core::kLliLossOfLock;
-        }
-      }
-      if (!first_time_) first_time_ = e.time;
-      last_time_ = e.time;
-      return std::move(*epoch);
-    }
-  }
-
-  [[nodiscard]] const io::RinexObsHeader& header() const { return reader_.header(); }
-  [[nodiscard]] double fraction_read() const { return reader_.fraction_read(); }
-  [[nodiscard]] const std::optional<core::GpsTime>& first_time() const { return first_time_; }
-  [[nodiscard]] const std::optional<core::GpsTime>& last_time() const { return last_time_; }
-
-  /// The reader's warnings and one for each kind of epoch handled above (call at the end: it stops the reading).
-  void append_warnings(std::vector<std::string>& out) {
-    const std::vector<std::string> warnings = reader_.finish();
-    out.insert(out.end(), warnings.begin(), warnings.end());
-    if (slip_records_ > 0) {
-      out.push_back(path_ + ": " + std::to_string(slip_records_) +
-                    " epochs of cycle-slip records (flag 6) are not observations, not used");
-    }
-    if (power_failures_ > 0) {
-      out.push_back(path_ + ": " + std::to_string(power_failures_) +
-                    " epochs after a power failure (flag 1): all their phases taken as lost lock");
-    }
-  }
-
- private:
-  ObservationStream(io::ObsReadAhead reader, std::string path) : reader_(std::move(reader)), path_(std::move(path)) {}
-
-  io::ObsReadAhead reader_;
-  std::string path_;
-  int slip_records_ = 0;
-  int power_failures_ = 0;
-  std::optional<core::GpsTime> first_time_;
-  std::optional<core::GpsTime> last_time_;
-};
-
-/// The base epochs, read one ahead of the one in use: at rover time t, the latest base epoch not later than t (plus
-/// a small tolerance for receivers whose time tags differ by milliseconds), or nullptr.
-class BaseCursor {
- public:
-  explicit BaseCursor(ObservationStream stream) : stream_(std::move(stream)) {}
-
-  Result<const core::ObsEpoch*> at(const core::GpsTime& t) {
-    constexpr double kToleranceS = 0.05;
-    if (!primed_) {
-      if (Status s = read_next(); !s) return s.error();
-      primed_ = true;
-    }
-    while (next_ && next_->time - t <= kToleranceS) {
-      current_ = std::move(next_);
-      if (Status s = read_next(); !s) return s.error();
-    }
-    if (current_ && current_->time - t <= kToleranceS) return &*current_;
-    return nullptr;
-  }
-
-  [[nodiscard]] ObservationStream& stream() { return stream_; }
-
- private:
-  Status read_next() {
-    auto epoch = stream_.next();
-    if (!epoch) return epoch.error();
-    next_ = std::move(*epoch);
-    return Ok{};
-  }
-
-  ObservationStream stream_;
-  std::optional<core::ObsEpoch> current_;
-  std::optional<core::ObsEpoch> next_;
-  bool primed_ = false;
-};
 
 Result<core::NavigationData> read_navigation(const std::vector<std::string>& paths,
                                              std::vector<std::string>& warnings) {
@@ -324,32 +225,65 @@ Status run_spp(const ProcessConfig& config, const gnss::EphemerisStore& ephemeri
   return Ok{};
 }
 
+/// Ingest for batch processing: the rover file epoch by epoch, each with its base epoch (BaseCursor).
+class FileEpochSource final : public EpochSource {
+ public:
+  FileEpochSource(ObservationStream& rover, BaseCursor& base) : rover_(rover), base_(base) {}
+
+  Result<std::optional<EpochItem>> next() override {
+    auto next = rover_.next();
+    if (!next) return next.error();
+    if (!*next) return std::optional<EpochItem>{};
+    std::optional<EpochItem> item(std::in_place);
+    item->rover = std::move(**next);
+    auto base_epoch = base_.at(item->rover.time);
+    if (!base_epoch) return base_epoch.error();
+    if (*base_epoch != nullptr) item->base = **base_epoch;
+    fraction_read_.store(rover_.fraction_read());
+    return item;
+  }
+  [[nodiscard]] double fraction_read() const { return fraction_read_.load(); }
+
+ private:
+  ObservationStream& rover_;
+  BaseCursor& base_;
+  std::atomic<double> fraction_read_{0.0};
+};
+
+/// The solutions of rtk and fusion modes: through the staged pipeline (sequential unless `pipeline` says threaded)
+/// to the outputs, with the summary's counts and notes.
+Status run_staged(EpochEstimator& estimator, ObservationStream& rover, BaseCursor& base, Outputs& writer,
+                  ProcessSummary& summary, const ProgressFn& progress, const PipelineOptions& pipeline,
+                  const std::function<void(const core::GpsTime&)>& on_epoch = {}) {
+  FileEpochSource source(rover, base);
+  const auto sink = [&](const EpochItem& item) -> Status {
+    if (on_epoch) on_epoch(item.rover.time);
+    ++summary.epochs;
+    if (item.output) {
+      const EpochOutput& out = *item.output;
+      if (Status w = writer.write(out.solution, out.hdop); !w) return w.error();
+      ++summary.solved;
+      if (out.solution.status == core::SolutionStatus::Fixed) {
+        ++summary.fixed;
+      } else {
+        add_epoch_note(summary, item.rover.time, status_word(out.solution.status), out.note);
+      }
+    } else if (item.error) {
+      add_epoch_note(summary, item.rover.time, "no solution", item.error->message);
+    }
+    if (progress) progress(summary.epochs, source.fraction_read());
+    return Ok{};
+  };
+  EpochPipeline runner(source, estimator, sink, pipeline);
+  return runner.run();
+}
+
 Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
                BaseCursor& base, const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
-               const ProgressFn& progress) {
+               const ProgressFn& progress, const PipelineOptions& pipeline) {
   rtk::RtkEngine engine(config.rtk, ephemerides, p_E_base);
-  for (;;) {
-    auto next = rover.next();
-    if (!next) return next.error();
-    if (!*next) break;
-    const core::ObsEpoch& epoch = **next;
-    ++summary.epochs;
-    auto base_epoch = base.at(epoch.time);
-    if (!base_epoch) return base_epoch.error();
-    auto result = engine.process(epoch, *base_epoch);
-    if (result) {
-      if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
-      ++summary.solved;
-      if (result->solution.status == core::SolutionStatus::Fixed) ++summary.fixed;
-      if (result->solution.status != core::SolutionStatus::Fixed) {
-        add_epoch_note(summary, epoch.time, status_word(result->solution.status), result->note);
-      }
-    } else {
-      add_epoch_note(summary, epoch.time, "no solution", result.error().message);
-    }
-    report(progress, summary, rover);
-  }
-  return Ok{};
+  RtkEstimator estimator(engine);
+  return run_staged(estimator, rover, base, writer, summary, progress, pipeline);
 }
 
 std::string gps_text(const core::GpsTime& t) {
@@ -407,40 +341,22 @@ Result<fusion::VioTrack> load_vio(const ProcessConfig& config, ProcessSummary& s
 
 Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
                   BaseCursor& base, const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
-                  const ProgressFn& progress) {
+                  const ProgressFn& progress, const PipelineOptions& pipeline) {
   auto track = load_vio(config, summary);
   if (!track) return track.error();
   const core::GpsTime vio_first = track->first_time();
   const core::GpsTime vio_last = track->last_time();
   fusion::FusionEngine engine(config.fusion, config.rtk, ephemerides, p_E_base, std::move(*track));
+  FusionEstimator estimator(engine);
   std::optional<core::GpsTime> first;
   core::GpsTime last;
   int overlapping = 0;
-  for (;;) {
-    auto next = rover.next();
-    if (!next) return next.error();
-    if (!*next) break;
-    const core::ObsEpoch& epoch = **next;
-    if (!first) first = epoch.time;
-    last = epoch.time;
-    if (!(epoch.time < vio_first) && !(vio_last < epoch.time)) ++overlapping;
-    ++summary.epochs;
-    auto base_epoch = base.at(epoch.time);
-    if (!base_epoch) return base_epoch.error();
-    auto result = engine.process(epoch, *base_epoch);
-    if (result) {
-      if (Status w = writer.write(result->solution, result->hdop); !w) return w.error();
-      ++summary.solved;
-      if (result->solution.status == core::SolutionStatus::Fixed) {
-        ++summary.fixed;
-      } else {
-        add_epoch_note(summary, epoch.time, status_word(result->solution.status), result->note);
-      }
-    } else {
-      add_epoch_note(summary, epoch.time, "no solution", result.error().message);
-    }
-    report(progress, summary, rover);
-  }
+  const auto on_epoch = [&](const core::GpsTime& t) {
+    if (!first) first = t;
+    last = t;
+    if (!(t < vio_first) && !(vio_last < t)) ++overlapping;
+  };
+  if (Status s = run_staged(estimator, rover, base, writer, summary, progress, pipeline, on_epoch); !s) return s;
   if (first && overlapping == 0) {
     return Error{"the VIO (GPST " + gps_text(vio_first) + " to " + gps_text(vio_last) +
                      ") does not overlap the rover epochs (GPST " + gps_text(*first) + " to " + gps_text(last) +
@@ -484,7 +400,8 @@ io::ObsFilter observation_filter(const ProcessConfig& config) {
 
 }  // namespace
 
-Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress) {
+Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress,
+                                   const PipelineOptions& pipeline) {
   const auto start = std::chrono::steady_clock::now();
   if (const std::string e = input_config.validate(); !e.empty()) return Error{e};
   ProcessConfig config = input_config;
@@ -495,7 +412,11 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   const io::ObsFilter filter = observation_filter(config);
   auto rover = ObservationStream::open(config.rover_obs, filter);
   std::optional<Result<ObservationStream>> base_stream;
-  if (config.mode != ProcessMode::Spp) base_stream.emplace(ObservationStream::open(config.base_obs, filter));
+  if (config.mode != ProcessMode::Spp) {
+    // An RTCM 3 base file dates its epochs from the rover's first epoch.
+    const std::optional<core::GpsTime> reference = rover ? rover->header().first_obs : std::nullopt;
+    base_stream.emplace(ObservationStream::open(config.base_obs, filter, reference));
+  }
 
   auto nav = read_navigation(config.nav, summary.warnings);
   if (!nav) return nav.error();
@@ -538,10 +459,10 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   Status run = Ok{};
   switch (config.mode) {
     case ProcessMode::Rtk:
-      run = run_rtk(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress);
+      run = run_rtk(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress, pipeline);
       break;
     case ProcessMode::Fusion:
-      run = run_fusion(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress);
+      run = run_fusion(config, ephemerides, *rover, *base, p_E_base, outputs, summary, progress, pipeline);
       break;
     case ProcessMode::Spp: run = run_spp(config, ephemerides, *rover, outputs, summary, progress); break;
   }
@@ -558,6 +479,27 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   }
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
+}
+
+}  // namespace canyon::app
+
+namespace canyon::app {
+
+Result<core::NavigationData> load_navigation(const std::vector<std::string>& paths,
+                                             std::vector<std::string>& warnings) {
+  return read_navigation(paths, warnings);
+}
+
+io::ObsFilter process_observation_filter(const ProcessConfig& config) {
+  return observation_filter(config);
+}
+
+Result<fusion::VioTrack> load_vio_track(const ProcessConfig& config, ProcessSummary& summary) {
+  return load_vio(config, summary);
+}
+
+std::vector<std::string> pos_header_lines(const ProcessConfig& config) {
+  return header_lines(config, {});
 }
 
 }  // namespace canyon::app

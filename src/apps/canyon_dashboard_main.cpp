@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
-#include <filesystem>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -30,20 +29,9 @@ extern "C" void on_signal(int /*signal*/) {
   g_stop.store(true);
 }
 
-/// The bundled page: next to the executable (build/web/dist) or the build tree this was compiled in.
-std::string default_web_dir(const char* argv0) {
-  std::error_code ec;
-  const auto self = std::filesystem::canonical("/proc/self/exe", ec);
-  for (const auto& dir :
-       {self.parent_path() / "web" / "dist", self.parent_path() / ".." / "share" / "canyon" / "web"}) {
-    if (!ec && std::filesystem::exists(dir / "index.html")) return dir.string();
-  }
-#ifdef CANYON_WEB_DIST_DIR
-  if (std::filesystem::exists(std::filesystem::path(CANYON_WEB_DIST_DIR) / "index.html")) return CANYON_WEB_DIST_DIR;
+#ifndef CANYON_WEB_DIST_DIR
+#define CANYON_WEB_DIST_DIR ""
 #endif
-  (void)argv0;
-  return {};
-}
 
 int run(int argc, char** argv) {
   CLI::App cli{"canyon-dashboard: live web dashboard and Prometheus /metrics of canyon monitor snapshots (JSON lines)"};
@@ -64,7 +52,7 @@ int run(int argc, char** argv) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : kExitUsage;
   }
-  if (options.web_dir.empty()) options.web_dir = default_web_dir(argv[0]);
+  if (options.web_dir.empty()) options.web_dir = canyon::dashboard::find_web_dir(CANYON_WEB_DIST_DIR);
   int fd = STDIN_FILENO;
   if (input != "-") {
     fd = ::open(input.c_str(), O_RDONLY | O_CLOEXEC);

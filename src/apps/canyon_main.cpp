@@ -72,6 +72,7 @@ struct ProcessArgs {
   bool print_config = false;
   bool quiet = false;
   bool verbose = false;
+  std::string pipeline;
 };
 
 void add_process_command(CLI::App& app, ProcessArgs& args) {
@@ -99,6 +100,10 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   cmd->add_option("--elevation-mask-deg", args.elevation_mask_deg, "Elevation mask (deg), default 15")
       ->check(CLI::Range(0.0, 89.9));
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
+  cmd->add_option("--pipeline", args.pipeline,
+                  "rtk and fusion: run the six stages sequential (one thread, the default) or threaded (six "
+                  "threads and queues, as canyon rover); both give the same solutions")
+      ->check(CLI::IsMember({"sequential", "threaded"}));
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
   cmd->add_flag("-v,--verbose", args.verbose, "Log why epochs got no solution or, in rtk mode, no fix (first 100)");
 }
@@ -171,8 +176,10 @@ int run_process_command(const ProcessArgs& args) {
     return kExitUsage;
   }
   ProgressBar bar(!args.quiet);
-  auto summary =
-      canyon::app::run_process(config, [&bar](int epochs, double fraction) { bar.update(epochs, fraction); });
+  canyon::app::PipelineOptions pipeline;
+  pipeline.threaded = args.pipeline == "threaded";
+  auto summary = canyon::app::run_process(
+      config, [&bar](int epochs, double fraction) { bar.update(epochs, fraction); }, pipeline);
   bar.finish();
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
@@ -537,6 +544,17 @@ int run_main(int argc, char** argv) {
   app.add_subcommand("base",
                      "Base station publishing RTCM 3 on DDS, NTRIP and TCP (runs canyon-base; canyon base --help)")
       ->allow_extras();
+  app.add_subcommand("rover", "Real-time rover: the staged pipeline over DDS (runs canyon-rover; canyon rover --help)")
+      ->allow_extras();
+  app.add_subcommand("record",
+                     "Record a DDS topic to a file: solutions to .pos/NMEA/CSV, others to a replayable log "
+                     "(runs canyon-record)")
+      ->allow_extras();
+  app.add_subcommand("echo", "Print the samples of a DDS topic (runs canyon-echo)")->allow_extras();
+  app.add_subcommand("monitor",
+                     "Stage and end-to-end latency, correction age, queues, drops, solution (runs "
+                     "canyon-monitor)")
+      ->allow_extras();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -583,7 +601,12 @@ int exec_dds_command(const std::string& command, int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  if (argc >= 2 && std::string(argv[1]) == "base") return exec_dds_command("base", argc, argv);
+  if (argc >= 2) {
+    const std::string command = argv[1];
+    for (const char* dds : {"base", "rover", "record", "echo", "monitor"}) {
+      if (command == dds) return exec_dds_command(command, argc, argv);
+    }
+  }
   // The heap grows in 16 MB steps and is not given back while the command runs: the reading threads' arenas would
   // otherwise grow and shrink by a page at a time, and on a virtual machine each of those system calls costs as much
   // as solving an epoch (cssrlib-kinematic: 196 mprotect calls, 10 ms of 45). Untouched pages cost no memory.

@@ -72,7 +72,12 @@ Result<std::string> parse_snapshot(const std::string& line) {
   if (!j.is_object()) return Error{"not a JSON object: '" + line.substr(0, 80) + "'"};
   if (!j.contains("t_s") || !j["t_s"].is_number()) return Error{"no number 't_s' in the snapshot"};
   for (const char* key : {"stages", "end_to_end", "queues", "drops", "solution", "alignment"}) {
-    if (j.contains(key) && !j[key].is_object()) return Error{std::string("'") + key + "' is not an object"};
+    if (!j.contains(key)) continue;
+    if (j[key].is_null()) {
+      j.erase(key);  // canyon monitor writes null before the first solution and without alignment (rtk mode)
+    } else if (!j[key].is_object()) {
+      return Error{std::string("'") + key + "' is not an object"};
+    }
   }
   return j.dump();
 }
@@ -282,6 +287,21 @@ void DashboardServer::routes() {
   } else {
     http.Get("/", [](const httplib::Request&, httplib::Response& res) { res.set_content(kNoBundle, "text/html"); });
   }
+}
+
+std::string find_web_dir(const std::string& compiled_dist_dir) {
+  std::error_code ec;
+  const auto self = std::filesystem::canonical("/proc/self/exe", ec);
+  if (!ec) {
+    for (const auto& dir :
+         {self.parent_path() / "web" / "dist", self.parent_path() / ".." / "share" / "canyon" / "web"}) {
+      if (std::filesystem::exists(dir / "index.html", ec)) return dir.string();
+    }
+  }
+  if (!compiled_dist_dir.empty() &&
+      std::filesystem::exists(std::filesystem::path(compiled_dist_dir) / "index.html", ec))
+    return compiled_dist_dir;
+  return {};
 }
 
 }  // namespace canyon::dashboard

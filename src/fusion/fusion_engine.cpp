@@ -177,19 +177,45 @@ std::string FusionEngine::validate_float(const rtk::RtkEpoch& epoch) const {
 }
 
 Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+  const std::optional<VioPoseAt> pose = bridge(rover.time);
+  align(rover.time, pose);
+  auto more = predict(rover, base, pose);
+  if (more && *more && update()) resolve();
+  Result<FusionEpoch> out = more ? Result<FusionEpoch>(finish_epoch()) : Result<FusionEpoch>(more.error());
+  flush_alignment();
+  return out;
+}
+
+std::optional<VioPoseAt> FusionEngine::bridge(const core::GpsTime& t) const {
+  return track_.pose_at(t);
+}
+
+void FusionEngine::align(const core::GpsTime& t, const std::optional<VioPoseAt>& pose) {
+  flush_alignment();
   ++stats_.epochs;
-  const std::optional<VioPoseAt> pose = track_.pose_at(rover.time);
   if (!pose) ++stats_.no_vio;
   if (pose && last_segment_ && *last_segment_ != pose->segment) {
-    stats_.notes.push_back(when(rover.time) + ": new VIO segment " + std::to_string(pose->segment) +
+    stats_.notes.push_back(when(t) + ": new VIO segment " + std::to_string(pose->segment) +
                            " (gap or reset): RTK motion model until it aligns");
   }
   if (pose) last_segment_ = pose->segment;
   if (alignment_ && pose && pose->segment != alignment_->segment) alignment_.reset();
+}
 
+void FusionEngine::flush_alignment() {
+  if (!pending_alignment_) return;
+  const PendingAlignment pending = std::move(*pending_alignment_);
+  pending_alignment_.reset();
+  update_alignment(pending.time, pending.pose);
+}
+
+Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base,
+                                   const std::optional<VioPoseAt>& pose) {
+  epoch_time_ = rover.time;
+  epoch_pose_ = pose;
   guard_rejections_epoch_ = 0;
   undetermined_fixes_epoch_ = 0;
-  std::optional<rtk::RtkAiding> aiding = make_aiding(rover.time, pose);
+  aiding_ = make_aiding(rover.time, pose);
   // The C/N0 screen learns from every epoch but screens only aided ones: before the VIO is aligned the RTK engine
   // needs every signal it can get for the solutions the alignment starts from.
   core::ObsEpoch screened;
@@ -198,26 +224,44 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
     screened = rover;
     const Eigen::Vector3d p_approx = prior_ ? prior_->p_E_m : engine_.position_E_m();
     const int removed = cn0_screen_.apply(screened, ephemerides_, p_approx);
-    if (aiding) {
+    if (aiding_) {
       stats_.cn0_screened += removed;
       observed = &screened;
     }
   }
-  auto result = engine_.process(*observed, base, aiding ? &*aiding : nullptr);
+  auto more = engine_.predict(*observed, base, aiding_ ? &*aiding_ : nullptr);
+  if (!more) {
+    count_fix_rejections();
+    pending_alignment_ = PendingAlignment{rover.time, pose};
+  }
+  return more;
+}
+
+bool FusionEngine::update() {
+  return engine_.update();
+}
+
+void FusionEngine::resolve() {
+  engine_.resolve();
+}
+
+void FusionEngine::count_fix_rejections() {
   if (undetermined_fixes_epoch_ > 0) ++stats_.undetermined_fix_epochs;
   if (guard_rejections_epoch_ > 0) {
     ++stats_.guard_epochs;
     stats_.guard_candidates += guard_rejections_epoch_;
   }
+}
+
+FusionEpoch FusionEngine::finish_epoch() {
+  const rtk::RtkEpoch epoch = engine_.take_epoch();
+  const rtk::RtkEpoch* result = &epoch;
+  count_fix_rejections();
   FusionEpoch out;
-  if (!result) {
-    update_alignment(rover.time, pose);
-    return result.error();
-  }
   stats_.gated_rows += static_cast<int>(result->rejected.size());
   out.hdop = result->hdop;
   out.note = result->note;
-  if (aiding && prior_) {
+  if (aiding_ && prior_) {
     out.aided = true;
     ++stats_.aided;
     std::string invalid;
@@ -254,7 +298,7 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
       // Algorithm 1, line 22: the prior, i.e. the aligned VIO fill-in.
       core::Solution& s = out.solution;
       s = result->solution;
-      if (s.status == core::SolutionStatus::None) s.time = rover.time;
+      if (s.status == core::SolutionStatus::None) s.time = epoch_time_;
       s.status = core::SolutionStatus::VioFillIn;
       s.p_E_m = result->aided ? result->prior_p_E_m : prior_->p_E_m;
       s.P_E_m2 = result->aided ? result->prior_P_E_m2 : prior_->P_E_m2;
@@ -270,20 +314,24 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
     ++stats_.fallback;
   }
   if (out.solution.status == core::SolutionStatus::Fixed) ++stats_.fixed;
+  out.rejected = result->rejected;
+  out.ar_pruned = result->ar_pruned;
+  out.rtk = epoch;
 
   // Remember the solution with its VIO pose for the alignment windows, and for the constant-velocity prediction.
+  const std::optional<VioPoseAt>& pose = epoch_pose_;
   if (pose && out.solution.status != core::SolutionStatus::VioFillIn &&
       out.solution.status != core::SolutionStatus::None) {
-    history_.push_back(WindowPoint{rover.time, pose->T_OI, out.solution.p_E_m, out.solution.status,
+    history_.push_back(WindowPoint{epoch_time_, pose->T_OI, out.solution.p_E_m, out.solution.status,
                                    sigma_3d(out.solution.P_E_m2), pose->segment, out.aided});
   }
   const double keep_s = std::max({options_.alignment_window_s, options_.coarse_window_s}) + 1.0;
-  while (!history_.empty() && rover.time - history_.front().time > keep_s) history_.erase(history_.begin());
+  while (!history_.empty() && epoch_time_ - history_.front().time > keep_s) history_.erase(history_.begin());
   if (out.solution.status == core::SolutionStatus::Fixed || out.solution.status == core::SolutionStatus::Float) {
     last_solutions_.push_back(out.solution);
     if (last_solutions_.size() > 2) last_solutions_.erase(last_solutions_.begin());
   }
-  update_alignment(rover.time, pose);
+  pending_alignment_ = PendingAlignment{epoch_time_, pose};
   return out;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 
@@ -1099,7 +1100,24 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   return true;
 }
 
+/// The epoch between the stages of process() (predict, update, resolve).
+struct RtkEngine::PendingEpoch {
+  RtkEpoch out;
+  std::vector<SingleDiff> sds;
+  bool consistent = true;
+};
+
+RtkEngine::~RtkEngine() = default;
+RtkEngine::RtkEngine(RtkEngine&&) noexcept = default;
+
 Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding) {
+  auto more = predict(rover, base, aiding);
+  if (!more) return more.error();
+  if (*more && update()) resolve();
+  return take_epoch();
+}
+
+Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding) {
   // The rover's satellite states are computed once, for the single-point solution, and reused by the zero
   // differences.
   has_prior_ = false;
@@ -1108,7 +1126,8 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_, &rover_states);
   if (!spp && aiding == nullptr) return spp.error();
 
-  RtkEpoch out;
+  pending_ = std::make_unique<PendingEpoch>();
+  RtkEpoch& out = pending_->out;
   core::Solution& sol = out.solution;
   if (spp) {
     last_spp_p_E_m_ = spp->p_E_m;
@@ -1129,13 +1148,13 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   }
   if (base == nullptr) {
     out.note = "no base observations";
-    return out;
+    return false;
   }
   const double age_s = rover.time - base->time;
   sol.age_s = age_s;
   if (age_s > options_.max_age_s || age_s < -kMaxBaseTimeAheadS) {
     out.note = "base observations too old (age " + std::to_string(age_s) + " s)";
-    return out;
+    return false;
   }
 
   if (options_.ar_mode == ArMode::Instantaneous) clear_ambiguities();
@@ -1148,8 +1167,8 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
   const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
   detect_slips(rover_obs, base_obs);
-  std::vector<SingleDiff> sds = single_differences(rover_obs, base_obs, rover_states);
-  update_ambiguities(sds, rover.time);
+  pending_->sds = single_differences(rover_obs, base_obs, rover_states);
+  update_ambiguities(pending_->sds, rover.time);
   if (aiding != nullptr) {
     out.aided = true;
     out.prior_p_E_m = x_.head<3>();
@@ -1160,6 +1179,14 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
     has_prior_ = true;
   }
   aiding_ = aiding;
+  return true;
+}
+
+bool RtkEngine::update() {
+  assert(pending_ && "update() after a predict() that returned true");
+  RtkEpoch& out = pending_->out;
+  std::vector<SingleDiff>& sds = pending_->sds;
+  core::Solution& sol = out.solution;
   last_code_rows_ = 0;
   bool consistent = true;
   out.num_dd_measurements = measurement_update(sds, out.rejected, consistent);
@@ -1168,7 +1195,7 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   if (out.num_dd_measurements == 0) {
     aiding_ = nullptr;
     out.note = "no double-differenced phase";
-    return out;
+    return false;
   }
   sol.status = core::SolutionStatus::Float;
   sol.p_E_m = x_.head<3>();
@@ -1186,10 +1213,25 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
     // trusted, and neither can integers fixed from them.
     out.note = "float solution failed validation (post-fit residuals beyond their thresholds after " +
                std::to_string(options_.max_post_fit_rejections) + " rejections)";
-    return out;
+    return false;
   }
-  if (options_.ar_mode != ArMode::Off) resolve_ambiguities(sds, out);
+  if (options_.ar_mode == ArMode::Off) {
+    aiding_ = nullptr;
+    return false;
+  }
+  return true;
+}
+
+void RtkEngine::resolve() {
+  assert(pending_ && "resolve() after an update() that returned true");
+  resolve_ambiguities(pending_->sds, pending_->out);
   aiding_ = nullptr;
+}
+
+RtkEpoch RtkEngine::take_epoch() {
+  assert(pending_ && "take_epoch() after a predict() that succeeded");
+  RtkEpoch out = std::move(pending_->out);
+  pending_.reset();
   return out;
 }
 

@@ -26,6 +26,10 @@ TEST(DashboardSnapshot, ParsesAndRefusesBadLines) {
   EXPECT_EQ(parse_snapshot("[1,2]").error().message.rfind("not a JSON object", 0), 0U);
   EXPECT_EQ(parse_snapshot(R"({"stages":{}})").error().message, "no number 't_s' in the snapshot");
   EXPECT_EQ(parse_snapshot(R"({"t_s":1,"solution":3})").error().message, "'solution' is not an object");
+  // canyon monitor before the first solution, and in rtk mode (no alignment): null objects are left out.
+  const auto early = parse_snapshot(R"({"t_s":1,"solution":null,"alignment":null,"queues":{}})");
+  ASSERT_TRUE(early.ok()) << early.error().message;
+  EXPECT_EQ(*early, R"({"queues":{},"t_s":1})");
 }
 
 TEST(DashboardSnapshot, PrometheusText) {

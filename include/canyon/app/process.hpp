@@ -5,10 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "canyon/app/epoch_pipeline.hpp"
 #include "canyon/app/process_config.hpp"
+#include "canyon/core/ephemeris.hpp"
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/core/satellite.hpp"
+#include "canyon/fusion/vio_track.hpp"
+#include "canyon/io/rinex_obs.hpp"
 
 namespace canyon::app {
 
@@ -39,6 +43,19 @@ using ProgressFn = std::function<void(int, double)>;
 
 /// Runs the configured mode over the whole input. Error (file and line) if an input cannot be read or the output
 /// cannot be written; an epoch that cannot be solved is counted and skipped.
-Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress = {});
+/// rtk and fusion modes run the staged pipeline (epoch_pipeline.hpp), sequentially unless `pipeline` says threaded;
+/// both give the same output.
+Result<ProcessSummary> run_process(const ProcessConfig& input_config, const ProgressFn& progress = {},
+                                   const PipelineOptions& pipeline = {});
+
+// Building blocks of run_process() that canyon rover shares.
+/// The ephemerides of RINEX navigation files (warnings appended).
+Result<core::NavigationData> load_navigation(const std::vector<std::string>& paths, std::vector<std::string>& warnings);
+/// What observation files are read for (constellations, frequencies) in the configured mode.
+[[nodiscard]] io::ObsFilter process_observation_filter(const ProcessConfig& config);
+/// The VIO track on GPST (vio.csv through the time bridge); notes go to the summary's report and warnings.
+Result<fusion::VioTrack> load_vio_track(const ProcessConfig& config, ProcessSummary& summary);
+/// The .pos header lines of the configuration.
+[[nodiscard]] std::vector<std::string> pos_header_lines(const ProcessConfig& config);
 
 }  // namespace canyon::app

@@ -36,6 +36,10 @@ Result<std::string> parse_snapshot(const std::string& line);
 /// Prometheus text exposition of a snapshot (compact JSON from parse_snapshot) and the server's own counters.
 std::string prometheus_text(const std::string& snapshot_json, std::uint64_t snapshots, std::uint64_t bad_lines);
 
+/// The bundled page's folder: web/dist next to the running executable, ../share/canyon/web, or `compiled_dist_dir`
+/// (the build tree's, given at compile time), the first holding index.html; empty when none does.
+std::string find_web_dir(const std::string& compiled_dist_dir);
+
 struct ServerOptions {
   std::string host = "127.0.0.1";  ///< address to listen on ("0.0.0.0": every interface)
   int port = 8080;                 ///< TCP port; 0: any free port (see DashboardServer::port)

@@ -102,8 +102,11 @@ struct FusionOptions {
 struct FusionEpoch {
   core::Solution solution;  ///< Fixed, Float, VioFillIn, or (fallback) the RTK engine's
   double hdop = 0.0;
-  bool aided = false;  ///< the VIO (or constant-velocity) prediction was used
-  std::string note;    ///< why the epoch is not fixed
+  bool aided = false;                        ///< the VIO (or constant-velocity) prediction was used
+  std::string note;                          ///< why the epoch is not fixed
+  std::vector<core::SatelliteId> rejected;   ///< satellites gated out of the update (innovation, post-fit)
+  std::vector<core::SatelliteId> ar_pruned;  ///< satellites pruned by the ambiguity resolution
+  rtk::RtkEpoch rtk;                         ///< the RTK engine's epoch (float solution, prior, DD rows)
 };
 
 struct AlignmentEvent {
@@ -149,8 +152,32 @@ class FusionEngine {
                const Eigen::Vector3d& p_E_base_m, VioTrack track);
 
   /// One rover epoch with the base epoch to use (nullptr if none). Error when no solution at all exists (no VIO
-  /// prediction and no single-point solution).
+  /// prediction and no single-point solution). The same as the stages below in order, then flush_alignment().
   Result<FusionEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base);
+
+  // The stages of process(), for the staged pipeline (app/epoch_pipeline.hpp). Per epoch, in this order:
+  //   bridge(t) -> align(t, pose) -> predict() -> [if true] update() -> [if true] resolve() -> finish_epoch().
+  // bridge() only reads the VIO track and may run ahead on another thread; the others change the engine's state and
+  // run one epoch at a time. The alignment that the paper runs after epoch k's solution runs at the start of align()
+  // of epoch k+1 (nothing happens in between, so the results are the same); flush_alignment() runs it at the end.
+  /// Time bridge: the VIO pose at GPST t (the track is on GPST through the time bridge), nullopt if none.
+  [[nodiscard]] std::optional<VioPoseAt> bridge(const core::GpsTime& t) const;
+  /// Alignment: the pending alignment of the previous epoch (T_EO, t_IA), then this epoch's VIO segment bookkeeping.
+  void align(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
+  /// Prediction: the VIO increment (Eqs. 3-6) as the RTK engine's aiding, the C/N0 screen, the RTK engine's
+  /// prediction (rtk::RtkEngine::predict). Error as process(); true if the epoch goes on to update().
+  Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const std::optional<VioPoseAt>& pose);
+  /// Update: the RTK engine's gated measurement update; true if the epoch goes on to resolve().
+  bool update();
+  /// Ambiguity resolution: the RTK engine's MLAMBDA with pruning and the false-fix guard.
+  void resolve();
+  /// Float validation, the fill-in, the epoch's output and the alignment window bookkeeping (after predict()
+  /// succeeded, whatever update() and resolve() did).
+  FusionEpoch finish_epoch();
+  /// Runs an alignment left pending by the last epoch (end of the input).
+  void flush_alignment();
+  /// The lever arm t_IA in use (the prior until calibrated) (m, IMU frame).
+  [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return t_IA_m_; }
 
   [[nodiscard]] const FusionStats& stats() const { return stats_; }
   /// Human-readable summary: alignments, calibration and lever-arm observability, validation and guard counts.
@@ -177,6 +204,12 @@ class FusionEngine {
     Eigen::Vector3d p_E_m;
     Eigen::Matrix3d P_E_m2;
   };
+
+  struct PendingAlignment {
+    core::GpsTime time;
+    std::optional<VioPoseAt> pose;
+  };
+  void count_fix_rejections();
 
   std::optional<rtk::RtkAiding> make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
   void update_alignment(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
@@ -205,6 +238,11 @@ class FusionEngine {
   std::vector<core::Solution> last_solutions_;  // the last two outputs (constant-velocity prediction)
   std::optional<int> last_segment_;
   FusionStats stats_;
+  // The epoch between the stages.
+  core::GpsTime epoch_time_;
+  std::optional<VioPoseAt> epoch_pose_;
+  std::optional<rtk::RtkAiding> aiding_;  // alive from predict() to finish_epoch(): the RTK engine points to it
+  std::optional<PendingAlignment> pending_alignment_;
 };
 
 }  // namespace canyon::fusion

@@ -63,6 +63,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -174,8 +175,29 @@ class RtkEngine {
  public:
   RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides, Eigen::Vector3d p_E_base_m);
 
+  ~RtkEngine();
+  RtkEngine(RtkEngine&&) noexcept;
+  RtkEngine& operator=(RtkEngine&&) = delete;
+  RtkEngine(const RtkEngine&) = delete;
+  RtkEngine& operator=(const RtkEngine&) = delete;
+
   /// Processes one rover epoch. Error only if not even a single-point solution exists (and, when aided, no prior).
+  /// The same as its three stages in order: predict(); if true, update(); if true, resolve(); then take_epoch().
   Result<RtkEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding = nullptr);
+
+  // The stages of process(), for the staged pipeline (app/epoch_pipeline.hpp); each runs after the one before on
+  // the same epoch, and `aiding` must stay alive until resolve() or take_epoch().
+  /// Prediction: single-point solution, time update (aided, or the engine's own motion model), observables, cycle
+  /// slips, single differences, ambiguity bookkeeping. Error as process(); true if the epoch goes on to update(),
+  /// false if its result is final (no base, base too old).
+  Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding = nullptr);
+  /// Measurement update (DD code and phase EKF with innovation gates and post-fit rejection) and the float solution;
+  /// true if the epoch goes on to resolve() (AR on, float consistent), false if its result is final.
+  bool update();
+  /// Ambiguity resolution: MLAMBDA, ratio test, partial fixing, the fixed solution.
+  void resolve();
+  /// The epoch's result (after predict() returned true or false).
+  RtkEpoch take_epoch();
   /// Undoes the measurement update and the ambiguity resolution of the last process() call, which must have been
   /// aided: the state goes back to that epoch's prior (ambiguities added or reset by slips that epoch stay).
   void revert_to_prior();
@@ -290,8 +312,11 @@ class RtkEngine {
   [[nodiscard]] int ambiguity_index(const AmbiguityKey& key) const;
   [[nodiscard]] int num_kinematic_states() const { return options_.dynamics ? 9 : 3; }
 
+  struct PendingEpoch;  // the epoch between the stages (engine.cpp)
+
   RtkOptions options_;
   const gnss::EphemerisStore& eph_;
+  std::unique_ptr<PendingEpoch> pending_;
   Eigen::Vector3d p_E_base_m_;
   Eigen::VectorXd x_;
   Eigen::MatrixXd P_;

@@ -1,0 +1,206 @@
+#pragma once
+// The estimation as six stages, run either in order on one thread (`canyon process`) or as six threads joined by
+// bounded lock-free single-producer/single-consumer queues (`canyon rover`). Both modes call the same stage
+// functions on the same engine in the same order, so they give the same solutions (tests/app/epoch_pipeline_test).
+//
+//   ingest ──▶ time bridge ──▶ alignment ──▶ prediction ──▶ update ──▶ ambiguity resolution ──▶ sink
+//      │  rover epoch + base   VIO pose at    pending T_EO /  VIO increment  gated DD EKF   MLAMBDA, ratio, pruning,
+//      │  epoch (BaseCursor    the epoch's    t_IA fit, VIO   as aiding, RTK  (RtkEngine::  float validation, fill-in,
+//      │  or DDS), stamped     GPST (track    segment book-   time update,    update)       output (finish_epoch)
+//      │  on arrival           on GPST)       keeping         single diffs
+//
+// What each stage does is the engine's own code (rtk::RtkEngine and fusion::FusionEngine expose their stages; see
+// their headers); rtk mode has no VIO: its time bridge and alignment stages pass epochs through.
+//
+// Honest about the parallelism: ingest (file parsing, base matching) and the time bridge (read-only VIO track) run
+// ahead freely. Alignment, prediction, update and ambiguity resolution share one estimator state and epoch k+1's
+// alignment needs epoch k's solution (the filter is recursive), so a token returned by the last stage admits one
+// epoch at a time into the alignment stage: those four stages overlap with ingest and the time bridge but not with
+// each other.
+//
+// Queue policy: GNSS epochs are never dropped. A full queue blocks its producer (back-pressure up to ingest, which
+// then reads its input later); each time a producer finds its queue full is counted (PipelineStats::full_waits).
+// Stop (stop()): ingest stops reading; every epoch already ingested goes through every stage and reaches the sink.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "canyon/core/observation.hpp"
+#include "canyon/core/result.hpp"
+#include "canyon/core/solution.hpp"
+#include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/fusion/vio_track.hpp"
+#include "canyon/rtk/engine.hpp"
+
+namespace canyon::app {
+
+enum class Stage : std::uint8_t { Ingest, TimeBridge, Alignment, Prediction, Update, Ambiguity };
+inline constexpr std::size_t kNumStages = 6;
+/// "ingest", "time_bridge", "alignment", "prediction", "update", "ambiguity".
+[[nodiscard]] const char* stage_name(Stage stage);
+/// The pipeline clock: monotonic nanoseconds (steady_clock).
+[[nodiscard]] std::int64_t monotonic_ns();
+
+/// The epoch's output.
+struct EpochOutput {
+  core::Solution solution;
+  double hdop = 0.0;
+  std::string note;  ///< why not fixed
+  std::vector<core::SatelliteId> rejected;
+  std::vector<core::SatelliteId> ar_pruned;
+  bool aided = false;
+  /// The update stage's float solution and the prediction's prior (aided epochs), from the RTK engine.
+  bool has_float = false;
+  Eigen::Vector3d float_p_E_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d float_P_E_m2 = Eigen::Matrix3d::Zero();
+  int dd_phase_rows = 0;
+  int dd_code_rows = 0;
+  double max_post_fit_normalised = 0.0;
+  bool has_prior = false;
+  Eigen::Vector3d prior_p_E_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d prior_P_E_m2 = Eigen::Matrix3d::Zero();
+  /// Fusion: the last accepted alignment (RMSE, first eigenvalue ratio) and the lever arm in use.
+  struct Alignment {
+    std::string kind;
+    double rmse_m = 0.0;
+    double first_eigenvalue_ratio = 0.0;
+    Eigen::Vector3d t_IA_m = Eigen::Vector3d::Zero();
+  };
+  std::optional<Alignment> alignment;
+};
+
+/// One epoch on its way through the stages.
+struct EpochItem {
+  std::uint64_t seq = 0;  ///< 0, 1, 2, ... in ingest order
+  core::ObsEpoch rover;
+  std::optional<core::ObsEpoch> base;  ///< the base epoch to use (a copy: ingest runs ahead of the cursor's users)
+  std::int64_t arrival_ns = 0;    ///< the epoch complete at ingest, rover and base (pipeline clock; 0: the pipeline
+                                  ///< stamps it when the source returns it); the ingest stage is timed from it
+  std::int64_t base_send_ns = 0;  ///< the base's send time of its epoch's last frame (DDS base; 0 otherwise)
+  std::array<std::int64_t, kNumStages> enter_ns{};  ///< per stage (pipeline clock)
+  std::array<std::int64_t, kNumStages> exit_ns{};
+  std::optional<fusion::VioPoseAt> pose;  ///< time bridge (fusion)
+  bool to_update = false;                 ///< prediction's verdict: the epoch goes on to the update
+  bool to_resolve = false;                ///< update's verdict: the epoch goes on to ambiguity resolution
+  std::optional<Error> error;             ///< no solution at all (the reason)
+  std::optional<EpochOutput> output;      ///< the solution (after the ambiguity stage)
+};
+
+/// Where epochs come from (the ingest stage): a rover epoch with its base epoch.
+class EpochSource {
+ public:
+  virtual ~EpochSource() = default;
+  /// The next epoch (rover, base; seq and times are set by the pipeline); nullopt at the end of the input.
+  virtual Result<std::optional<EpochItem>> next() = 0;
+};
+
+/// The estimator's stages (see the engines' headers for what each does). bridge() is const and may run on another
+/// thread than the others; the others run one epoch at a time, in order.
+class EpochEstimator {
+ public:
+  virtual ~EpochEstimator() = default;
+  virtual void bridge(EpochItem& item) const = 0;
+  virtual void align(EpochItem& item) = 0;
+  virtual void predict(EpochItem& item) = 0;
+  virtual void update(EpochItem& item) = 0;
+  /// Ambiguity resolution (when the update asked for it) and the epoch's output.
+  virtual void resolve(EpochItem& item) = 0;
+  /// End of the input (a pending alignment).
+  virtual void finish() = 0;
+};
+
+/// RTK (rtk::RtkEngine): no VIO, so no time bridge and no alignment.
+class RtkEstimator final : public EpochEstimator {
+ public:
+  explicit RtkEstimator(rtk::RtkEngine& engine) : engine_(engine) {}
+  void bridge(EpochItem& /*item*/) const override {}
+  void align(EpochItem& /*item*/) override {}
+  void predict(EpochItem& item) override;
+  void update(EpochItem& item) override;
+  void resolve(EpochItem& item) override;
+  void finish() override {}
+
+ private:
+  rtk::RtkEngine& engine_;
+};
+
+/// The paper's fusion (fusion::FusionEngine).
+class FusionEstimator final : public EpochEstimator {
+ public:
+  explicit FusionEstimator(fusion::FusionEngine& engine) : engine_(engine) {}
+  void bridge(EpochItem& item) const override;
+  void align(EpochItem& item) override;
+  void predict(EpochItem& item) override;
+  void update(EpochItem& item) override;
+  void resolve(EpochItem& item) override;
+  void finish() override { engine_.flush_alignment(); }
+
+ private:
+  fusion::FusionEngine& engine_;
+};
+
+/// Receives each epoch after its last stage (on the ambiguity stage's thread); an error stops the pipeline.
+using EpochSink = std::function<Status(const EpochItem&)>;
+/// Called on a stage's thread when it finished with an epoch (e.g. to publish the stage's output); must be quick.
+using StageObserver = std::function<void(Stage, const EpochItem&)>;
+
+struct PipelineOptions {
+  bool threaded = false;            ///< six threads and queues; false: one thread, stage after stage
+  std::size_t queue_capacity = 64;  ///< epochs per queue (threaded)
+  [[nodiscard]] std::string validate() const;
+};
+
+struct PipelineStats {
+  std::uint64_t epochs = 0;  ///< epochs that reached the sink
+  /// Per queue (ingest->bridge, bridge->alignment, alignment->prediction, prediction->update, update->ambiguity):
+  /// times its producer found it full and waited.
+  std::array<std::uint64_t, kNumStages - 1> full_waits{};
+};
+
+class EpochPipeline {
+ public:
+  EpochPipeline(EpochSource& source, EpochEstimator& estimator, EpochSink sink, PipelineOptions options,
+                StageObserver observer = {});
+  ~EpochPipeline();
+  EpochPipeline(const EpochPipeline&) = delete;
+  EpochPipeline& operator=(const EpochPipeline&) = delete;
+
+  /// Runs until the source ends, stop() is called, or an error (source, sink). Epochs already ingested are finished
+  /// either way. The first error, if any.
+  Status run();
+  /// Asks ingest to stop reading (thread- and signal-safe: one atomic store).
+  void stop() { stop_.store(true); }
+  [[nodiscard]] bool stop_requested() const { return stop_.load(); }
+  /// Epochs in each queue now (approximate, thread-safe; all zero when sequential).
+  [[nodiscard]] std::array<std::size_t, kNumStages - 1> queue_depths() const;
+  [[nodiscard]] PipelineStats stats() const;
+
+ private:
+  struct Queues;
+  Status run_sequential();
+  Status run_threaded();
+  void run_stage(Stage stage, EpochItem& item);
+  void fail(const Error& error);
+
+  EpochSource& source_;
+  EpochEstimator& estimator_;
+  EpochSink sink_;
+  PipelineOptions options_;
+  StageObserver observer_;
+  std::unique_ptr<Queues> queues_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> failed_{false};
+  std::atomic<std::uint64_t> epochs_{0};
+  std::array<std::atomic<std::uint64_t>, kNumStages - 1> full_waits_{};
+  std::mutex error_mutex_;
+  Error error_;  // the first error (under error_mutex_)
+};
+
+}  // namespace canyon::app

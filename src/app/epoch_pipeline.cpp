@@ -1,0 +1,293 @@
+// The staged estimation pipeline (see epoch_pipeline.hpp).
+
+#include "canyon/app/epoch_pipeline.hpp"
+
+#include <thread>
+#include <utility>
+
+#include <readerwriterqueue/readerwritercircularbuffer.h>
+
+#include "canyon/core/time.hpp"
+
+namespace canyon::app {
+namespace {
+
+void copy_filter(const rtk::RtkEpoch& epoch, EpochOutput& out) {
+  out.has_float = epoch.num_dd_measurements > 0;
+  out.float_p_E_m = epoch.float_p_E_m;
+  out.float_P_E_m2 = epoch.float_P_E_m2;
+  out.dd_phase_rows = epoch.num_dd_measurements;
+  out.dd_code_rows = epoch.num_dd_code_measurements;
+  out.max_post_fit_normalised = epoch.max_post_fit_normalised;
+  out.has_prior = epoch.aided;
+  out.prior_p_E_m = epoch.prior_p_E_m;
+  out.prior_P_E_m2 = epoch.prior_P_E_m2;
+}
+
+}  // namespace
+
+const char* stage_name(Stage stage) {
+  switch (stage) {
+    case Stage::Ingest: return "ingest";
+    case Stage::TimeBridge: return "time_bridge";
+    case Stage::Alignment: return "alignment";
+    case Stage::Prediction: return "prediction";
+    case Stage::Update: return "update";
+    case Stage::Ambiguity: return "ambiguity";
+  }
+  return "?";
+}
+
+std::int64_t monotonic_ns() {
+  return core::pipeline_now_ns();
+}
+
+// ---- Estimators: the engines' stages ----
+
+void RtkEstimator::predict(EpochItem& item) {
+  const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
+  auto more = engine_.predict(item.rover, base);
+  if (!more) {
+    item.error = more.error();
+    return;
+  }
+  item.to_update = *more;
+}
+
+void RtkEstimator::update(EpochItem& item) {
+  if (item.to_update) item.to_resolve = engine_.update();
+}
+
+void RtkEstimator::resolve(EpochItem& item) {
+  if (item.error) return;
+  if (item.to_resolve) engine_.resolve();
+  rtk::RtkEpoch epoch = engine_.take_epoch();
+  EpochOutput out;
+  copy_filter(epoch, out);
+  out.solution = epoch.solution;
+  out.hdop = epoch.hdop;
+  out.note = std::move(epoch.note);
+  out.rejected = std::move(epoch.rejected);
+  out.ar_pruned = std::move(epoch.ar_pruned);
+  item.output = std::move(out);
+}
+
+void FusionEstimator::bridge(EpochItem& item) const {
+  item.pose = engine_.bridge(item.rover.time);
+}
+
+void FusionEstimator::align(EpochItem& item) {
+  engine_.align(item.rover.time, item.pose);
+}
+
+void FusionEstimator::predict(EpochItem& item) {
+  const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
+  auto more = engine_.predict(item.rover, base, item.pose);
+  if (!more) {
+    item.error = more.error();
+    return;
+  }
+  item.to_update = *more;
+}
+
+void FusionEstimator::update(EpochItem& item) {
+  if (item.to_update) item.to_resolve = engine_.update();
+}
+
+void FusionEstimator::resolve(EpochItem& item) {
+  if (item.error) return;
+  if (item.to_resolve) engine_.resolve();
+  fusion::FusionEpoch epoch = engine_.finish_epoch();
+  EpochOutput out;
+  copy_filter(epoch.rtk, out);
+  out.solution = epoch.solution;
+  out.hdop = epoch.hdop;
+  out.note = std::move(epoch.note);
+  out.rejected = std::move(epoch.rejected);
+  out.ar_pruned = std::move(epoch.ar_pruned);
+  out.aided = epoch.aided;
+  if (!engine_.stats().alignments.empty()) {
+    const fusion::AlignmentEvent& a = engine_.stats().alignments.back();
+    out.alignment = EpochOutput::Alignment{a.kind, a.rmse_m, a.first_eigenvalue_ratio, engine_.lever_arm_m()};
+  }
+  item.output = std::move(out);
+}
+
+// ---- The pipeline ----
+
+std::string PipelineOptions::validate() const {
+  if (queue_capacity < 1 || queue_capacity > 65536) return "queue_capacity must be in 1..65536";
+  return {};
+}
+
+using ItemPtr = std::unique_ptr<EpochItem>;  // nullptr: end of the stream
+using ItemQueue = moodycamel::BlockingReaderWriterCircularBuffer<ItemPtr>;
+
+struct EpochPipeline::Queues {
+  explicit Queues(std::size_t capacity) {
+    for (auto& q : between) q = std::make_unique<ItemQueue>(capacity);
+  }
+  std::array<std::unique_ptr<ItemQueue>, kNumStages - 1> between;  // stage i -> stage i + 1
+  moodycamel::BlockingReaderWriterCircularBuffer<bool> tokens{
+      2};  // ambiguity -> alignment: the estimator state is free for the next epoch
+};
+
+EpochPipeline::EpochPipeline(EpochSource& source, EpochEstimator& estimator, EpochSink sink, PipelineOptions options,
+                             StageObserver observer)
+    : source_(source),
+      estimator_(estimator),
+      sink_(std::move(sink)),
+      options_(options),
+      observer_(std::move(observer)) {
+  for (auto& w : full_waits_) w.store(0);
+  if (options_.threaded) queues_ = std::make_unique<Queues>(options_.queue_capacity);
+}
+
+EpochPipeline::~EpochPipeline() = default;
+
+void EpochPipeline::fail(const Error& error) {
+  const std::lock_guard lock(error_mutex_);
+  if (failed_.load()) return;
+  error_ = error;
+  failed_.store(true);
+  stop_.store(true);
+}
+
+std::array<std::size_t, kNumStages - 1> EpochPipeline::queue_depths() const {
+  std::array<std::size_t, kNumStages - 1> depths{};
+  if (!queues_) return depths;
+  for (std::size_t i = 0; i < depths.size(); ++i) depths[i] = queues_->between[i]->size_approx();
+  return depths;
+}
+
+PipelineStats EpochPipeline::stats() const {
+  PipelineStats s;
+  s.epochs = epochs_.load();
+  for (std::size_t i = 0; i < s.full_waits.size(); ++i) s.full_waits[i] = full_waits_[i].load();
+  return s;
+}
+
+/// One stage (not ingest) on one epoch, with its enter and exit times.
+void EpochPipeline::run_stage(Stage stage, EpochItem& item) {
+  const auto i = static_cast<std::size_t>(stage);
+  item.enter_ns[i] = monotonic_ns();
+  switch (stage) {
+    case Stage::Ingest: break;
+    case Stage::TimeBridge: estimator_.bridge(item); break;
+    case Stage::Alignment: estimator_.align(item); break;
+    case Stage::Prediction: estimator_.predict(item); break;
+    case Stage::Update:
+      if (!item.error) estimator_.update(item);
+      break;
+    case Stage::Ambiguity: estimator_.resolve(item); break;
+  }
+  item.exit_ns[i] = monotonic_ns();
+  if (observer_) observer_(stage, item);
+}
+
+Status EpochPipeline::run() {
+  if (const std::string e = options_.validate(); !e.empty()) return Error{"pipeline: " + e};
+  Status s = options_.threaded ? run_threaded() : run_sequential();
+  if (!s) return s;
+  const std::lock_guard lock(error_mutex_);
+  if (failed_.load()) return error_;
+  return Ok{};
+}
+
+Status EpochPipeline::run_sequential() {
+  for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
+    const std::int64_t enter = monotonic_ns();
+    auto next = source_.next();
+    if (!next) return next.error();
+    if (!*next) break;
+    EpochItem& item = **next;
+    item.seq = seq;
+    if (item.arrival_ns == 0) item.arrival_ns = enter;
+    item.enter_ns[0] = item.arrival_ns;
+    item.exit_ns[0] = monotonic_ns();
+    if (observer_) observer_(Stage::Ingest, item);
+    for (std::size_t s = 1; s < kNumStages; ++s) run_stage(static_cast<Stage>(s), item);
+    ++epochs_;
+    if (Status w = sink_(item); !w) return w;
+  }
+  estimator_.finish();
+  return Ok{};
+}
+
+Status EpochPipeline::run_threaded() {
+  Queues& q = *queues_;
+  const auto push = [this, &q](std::size_t i, ItemPtr item) {
+    if (!q.between[i]->try_enqueue(std::move(item))) {
+      ++full_waits_[i];
+      q.between[i]->wait_enqueue(std::move(item));  // never drops: back-pressure
+    }
+  };
+
+  // Ingest.
+  std::thread ingest([this, &push] {
+    for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
+      const std::int64_t enter = monotonic_ns();
+      auto next = source_.next();
+      if (!next) {
+        fail(next.error());
+        break;
+      }
+      if (!*next) break;
+      auto item = std::make_unique<EpochItem>(std::move(**next));
+      item->seq = seq;
+      if (item->arrival_ns == 0) item->arrival_ns = enter;
+      item->enter_ns[0] = item->arrival_ns;
+      item->exit_ns[0] = monotonic_ns();
+      if (observer_) observer_(Stage::Ingest, *item);
+      push(0, std::move(item));
+    }
+    push(0, nullptr);
+  });
+
+  // Middle stages: time bridge, alignment (waits for the token), prediction, update.
+  const auto middle = [this, &q, &push](Stage stage) {
+    const auto in = static_cast<std::size_t>(stage) - 1;
+    bool first = true;
+    for (;;) {
+      ItemPtr item;
+      q.between[in]->wait_dequeue(item);
+      if (!item) break;
+      if (stage == Stage::Alignment) {
+        if (!first) {
+          bool token = false;
+          q.tokens.wait_dequeue(token);
+        }
+        first = false;
+      }
+      run_stage(stage, *item);
+      push(in + 1, std::move(item));
+    }
+    push(in + 1, nullptr);
+  };
+  std::thread bridge(middle, Stage::TimeBridge);
+  std::thread align(middle, Stage::Alignment);
+  std::thread predict(middle, Stage::Prediction);
+  std::thread update(middle, Stage::Update);
+
+  // Ambiguity resolution and the sink, on this thread.
+  for (;;) {
+    ItemPtr item;
+    q.between[kNumStages - 2]->wait_dequeue(item);
+    if (!item) break;
+    run_stage(Stage::Ambiguity, *item);
+    q.tokens.wait_enqueue(true);  // the estimator is free for the next epoch's alignment
+    ++epochs_;
+    if (!failed_.load()) {
+      if (Status w = sink_(*item); !w) fail(w.error());
+    }
+  }
+  ingest.join();
+  bridge.join();
+  align.join();
+  predict.join();
+  update.join();
+  estimator_.finish();
+  return Ok{};
+}
+
+}  // namespace canyon::app

@@ -1,0 +1,434 @@
+// canyon-rover: the real-time rover. The rover's observations replayed from RINEX at real-time pace (or faster),
+// base corrections from a RINEX file or from the DDS RtcmFrame topic, VIO from files, through the six-stage threaded
+// pipeline (app/epoch_pipeline.hpp, the same stages as canyon process); solutions and stage timing published on DDS
+// (idl/RoverPipeline.idl). `canyon rover ...` runs this executable; config/rover.yaml documents the configuration.
+// SIGINT/SIGTERM stop it cleanly: ingest stops, the epochs in flight are finished and published.
+// Exit codes: 0 success, 1 input or runtime failure, 2 bad command line or configuration.
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <readerwriterqueue/readerwritercircularbuffer.h>
+#include <spdlog/spdlog.h>
+
+#include "canyon/app/epoch_pipeline.hpp"
+#include "canyon/app/observation_stream.hpp"
+#include "canyon/app/process.hpp"
+#include "canyon/app/rover_config.hpp"
+#include "canyon/gnss/ephemeris.hpp"
+#include "canyon/io/pos_file.hpp"
+#include "canyon/pipeline/dds.hpp"
+#include "canyon/pipeline/rover_msgs.hpp"
+#include "canyon/pipeline/rtcm_frame.hpp"
+
+namespace {
+
+constexpr int kExitRuntime = 1;
+constexpr int kExitUsage = 2;
+
+using canyon::Result;
+using canyon::Status;
+namespace app = canyon::app;
+namespace core = canyon::core;
+namespace pl = canyon::pipeline;
+
+std::atomic<app::EpochPipeline*> g_pipeline{nullptr};
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_signal(int /*signal*/) {
+  g_stop.store(true);
+  if (app::EpochPipeline* p = g_pipeline.load()) p->stop();
+}
+
+/// An RTCM frame from the DDS listener to ingest.
+struct BaseFrameSample {
+  std::vector<std::uint8_t> bytes;
+  std::int64_t send_ns = 0;
+};
+
+/// Ingest: the rover file at its pace; the base from a file (BaseCursor) or from DDS (LiveBaseCursor).
+class RoverSource final : public app::EpochSource {
+ public:
+  RoverSource(app::ObservationStream rover, double pace, std::optional<app::BaseCursor> file_base,
+              moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>* dds_frames, double base_wait_s)
+      : rover_(std::move(rover)),
+        pace_(pace),
+        file_base_(std::move(file_base)),
+        dds_frames_(dds_frames),
+        base_wait_ns_(static_cast<std::int64_t>(base_wait_s * 1e9)) {}
+
+  Result<std::optional<app::EpochItem>> next() override {
+    auto next = rover_.next();
+    if (!next) return next.error();
+    if (!*next) return std::optional<app::EpochItem>{};
+    std::optional<app::EpochItem> item(std::in_place);
+    item->rover = std::move(**next);
+    const core::GpsTime t = item->rover.time;
+    if (!wait_until_due(t)) return std::optional<app::EpochItem>{};  // stopped
+    if (file_base_) {
+      auto base = file_base_->at(t);
+      if (!base) return base.error();
+      if (*base != nullptr) item->base = **base;
+    } else if (dds_frames_ != nullptr) {
+      if (!live_) {
+        live_.emplace(t, [this](std::int64_t timeout_us) { return poll(timeout_us); });
+      }
+      const app::LiveBaseCursor::Match match = live_->at(t, core::pipeline_now_ns() + base_wait_ns_);
+      if (match.late) base_late_.fetch_add(1);
+      if (match.epoch != nullptr) item->base = *match.epoch;
+      item->base_send_ns = match.send_ns;
+    }
+    item->arrival_ns = core::pipeline_now_ns();  // the epoch is complete (rover and base) and enters the stages
+    return item;
+  }
+
+  [[nodiscard]] std::uint64_t base_late() const { return base_late_.load(); }
+
+ private:
+  /// Sleeps until the rover epoch at t is due at the replay pace; false if stopped meanwhile.
+  bool wait_until_due(const core::GpsTime& t) {
+    if (!(pace_ > 0.0)) return !g_stop.load();
+    const std::int64_t now = core::pipeline_now_ns();
+    if (!first_) first_ = std::make_pair(t, now);
+    const auto due = first_->second + static_cast<std::int64_t>((t - first_->first) / pace_ * 1e9);
+    while (!g_stop.load()) {
+      const std::int64_t left = due - core::pipeline_now_ns();
+      if (left <= 0) return true;
+      std::this_thread::sleep_for(std::chrono::nanoseconds(std::min<std::int64_t>(left, 50'000'000)));
+    }
+    return false;
+  }
+
+  bool poll(std::int64_t timeout_us) {
+    BaseFrameSample frame;
+    if (!dds_frames_->wait_dequeue_timed(frame, timeout_us)) return !g_stop.load();
+    live_->push(frame.bytes, frame.send_ns);
+    while (dds_frames_->try_dequeue(frame)) live_->push(frame.bytes, frame.send_ns);
+    return true;
+  }
+
+  app::ObservationStream rover_;
+  double pace_;
+  std::optional<app::BaseCursor> file_base_;
+  moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>* dds_frames_;
+  std::int64_t base_wait_ns_;
+  std::optional<app::LiveBaseCursor> live_;
+  std::optional<std::pair<core::GpsTime, std::int64_t>> first_;
+  std::atomic<std::uint64_t> base_late_{0};
+};
+
+int run(int argc, char** argv) {
+  CLI::App cli{"canyon-rover: the real-time rover pipeline (six stage threads, DDS in and out)"};
+  std::string config_file;
+  bool print_config = false;
+  double pace = -1.0;
+  std::string out;
+  int wait_subscribers = 0;
+  double wait_timeout_s = 30.0;
+  bool quiet = false;
+  std::string pipeline_mode;
+  cli.add_option("--config", config_file, "YAML configuration (strict; config/rover.yaml documents every key)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cli.add_flag("--print-config", print_config, "Print the effective configuration as YAML and exit");
+  cli.add_option("--pace", pace, "Override input.pace (rover replay speed; 0 as fast as possible)")
+      ->check(CLI::NonNegativeNumber);
+  cli.add_option("--out", out, "Override estimator.out (.pos the rover writes itself)");
+  cli.add_option("--pipeline", pipeline_mode, "Override pipeline.threaded: threaded or sequential")
+      ->check(CLI::IsMember({"threaded", "sequential"}));
+  cli.add_option("--wait-for-subscribers", wait_subscribers,
+                 "Start once this many readers of the solution topic are matched (so they miss nothing)")
+      ->check(CLI::NonNegativeNumber);
+  cli.add_option("--wait-timeout", wait_timeout_s, "Give up waiting for subscribers after this many seconds");
+  cli.add_flag("-q,--quiet", quiet, "Warnings and errors only");
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = cli.exit(e);
+    return code == 0 ? 0 : kExitUsage;
+  }
+  spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [canyon-rover] [%^%l%$] %v");
+  if (quiet) spdlog::set_level(spdlog::level::warn);
+
+  auto config = app::load_rover_config(config_file);
+  if (!config) {
+    spdlog::error("{}", config.error().to_string());
+    return kExitUsage;
+  }
+  if (pace >= 0.0) config->pace = pace;
+  if (!out.empty()) config->estimator.out = out;
+  if (!pipeline_mode.empty()) config->pipeline.threaded = pipeline_mode == "threaded";
+  if (print_config) {
+    std::cout << app::to_yaml(*config);
+    return 0;
+  }
+  if (const std::string e = config->validate(); !e.empty()) {
+    spdlog::error("{}: {}", config_file, e);
+    return kExitUsage;
+  }
+  const app::ProcessConfig& est = config->estimator;
+  const bool dds_base = config->base == app::RoverBaseSource::Dds;
+
+  // DDS first: profiles before any participant.
+  std::string profiles = config->profiles;
+  if (profiles.empty()) {
+    auto found = pl::default_profiles_file();
+    if (!found) {
+      spdlog::error("{}", found.error().to_string());
+      return kExitUsage;
+    }
+    profiles = *found;
+  }
+  if (auto s = pl::load_profiles(profiles); !s.ok()) {
+    spdlog::error("{}", s.error().to_string());
+    return kExitUsage;
+  }
+  auto participant = pl::DdsParticipant::create(config->domain);
+  if (!participant) {
+    spdlog::error("{}", participant.error().to_string());
+    return kExitRuntime;
+  }
+  auto solution_writer = pl::SolutionWriter::create(**participant, config->solution_topic, "solution_writer");
+  auto timing_writer = pl::TimingWriter::create(**participant, config->timing_topic, "timing_writer");
+  if (!solution_writer || !timing_writer) {
+    spdlog::error("{}", (!solution_writer ? solution_writer.error() : timing_writer.error()).to_string());
+    return kExitRuntime;
+  }
+  std::unique_ptr<pl::BridgedWriter> bridged_writer;
+  std::unique_ptr<pl::AlignmentWriter> alignment_writer;
+  std::unique_ptr<pl::PriorWriter> prior_writer;
+  std::unique_ptr<pl::FloatWriter> float_writer;
+  if (config->publish_stages) {
+    auto p = pl::PriorWriter::create(**participant, "canyon/prior", "stage_writer");
+    auto f = pl::FloatWriter::create(**participant, "canyon/float", "stage_writer");
+    if (!p || !f) {
+      spdlog::error("{}", (!p ? p.error() : f.error()).to_string());
+      return kExitRuntime;
+    }
+    prior_writer = std::move(*p);
+    float_writer = std::move(*f);
+    if (est.mode == app::ProcessMode::Fusion) {
+      auto b = pl::BridgedWriter::create(**participant, "canyon/bridged", "stage_writer");
+      auto a = pl::AlignmentWriter::create(**participant, "canyon/alignment", "stage_writer");
+      if (!b || !a) {
+        spdlog::error("{}", (!b ? b.error() : a.error()).to_string());
+        return kExitRuntime;
+      }
+      bridged_writer = std::move(*b);
+      alignment_writer = std::move(*a);
+    }
+  }
+
+  // Base frames: the DDS listener only queues them (dropped and counted when the queue is full).
+  moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample> base_frames(config->base_queue_frames);
+  std::atomic<std::uint64_t> base_frames_dropped{0};
+  std::atomic<std::uint64_t> base_frames_bad{0};
+  std::unique_ptr<pl::RtcmReader> rtcm_reader;
+  if (dds_base) {
+    auto r = pl::RtcmReader::create(
+        **participant, config->rtcm_topic, "rtcm_reader",
+        [&base_frames, &base_frames_dropped, &base_frames_bad](canyon::msg::RtcmFrame&& m) {
+          auto frame = pl::from_msg(m);
+          if (!frame) {
+            base_frames_bad.fetch_add(1);
+            return;
+          }
+          if (!base_frames.try_enqueue(BaseFrameSample{std::move(frame->bytes), m.send_monotonic_ns()})) {
+            base_frames_dropped.fetch_add(1);
+          }
+        });
+    if (!r) {
+      spdlog::error("{}", r.error().to_string());
+      return kExitRuntime;
+    }
+    rtcm_reader = std::move(*r);
+  }
+
+  // The estimator, as canyon process builds it.
+  app::ProcessSummary notes;
+  auto nav = app::load_navigation(est.nav, notes.warnings);
+  if (!nav) {
+    spdlog::error("{}", nav.error().to_string());
+    return kExitRuntime;
+  }
+  const canyon::gnss::EphemerisStore ephemerides(std::move(*nav));
+  const canyon::io::ObsFilter filter = app::process_observation_filter(est);
+  auto rover = app::ObservationStream::open(est.rover_obs, filter);
+  if (!rover) {
+    spdlog::error("{}", rover.error().to_string());
+    return kExitRuntime;
+  }
+  std::optional<app::BaseCursor> file_base;
+  Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
+  if (!dds_base) {
+    auto base = app::ObservationStream::open(est.base_obs, filter, rover->header().first_obs);
+    if (!base) {
+      spdlog::error("{}", base.error().to_string());
+      return kExitRuntime;
+    }
+    if (est.base_position_E_m) {
+      p_E_base = *est.base_position_E_m;
+    } else if (base->header().receiver.approx_position_E_m) {
+      p_E_base = *base->header().receiver.approx_position_E_m;
+    } else {
+      spdlog::error("{}: no base position: give estimator.base_position", est.base_obs);
+      return kExitUsage;
+    }
+    file_base.emplace(std::move(*base));
+  } else if (est.base_position_E_m) {
+    p_E_base = *est.base_position_E_m;
+  } else {
+    spdlog::error("{}: input.base dds needs estimator.base_position (the base's ECEF antenna position)", config_file);
+    return kExitUsage;
+  }
+  std::unique_ptr<canyon::rtk::RtkEngine> rtk_engine;
+  std::unique_ptr<canyon::fusion::FusionEngine> fusion_engine;
+  std::unique_ptr<app::EpochEstimator> estimator;
+  if (est.mode == app::ProcessMode::Fusion) {
+    auto track = app::load_vio_track(est, notes);
+    if (!track) {
+      spdlog::error("{}", track.error().to_string());
+      return kExitRuntime;
+    }
+    fusion_engine =
+        std::make_unique<canyon::fusion::FusionEngine>(est.fusion, est.rtk, ephemerides, p_E_base, std::move(*track));
+    estimator = std::make_unique<app::FusionEstimator>(*fusion_engine);
+  } else {
+    rtk_engine = std::make_unique<canyon::rtk::RtkEngine>(est.rtk, ephemerides, p_E_base);
+    estimator = std::make_unique<app::RtkEstimator>(*rtk_engine);
+  }
+  for (const std::string& w : notes.warnings) spdlog::warn("{}", w);
+  for (const std::string& r : notes.report) spdlog::info("{}", r);
+
+  std::optional<canyon::io::PosWriter> pos;
+  if (!est.out.empty()) {
+    auto p = canyon::io::PosWriter::create(est.out, {est.coordinates, est.time_format, app::pos_header_lines(est)});
+    if (!p) {
+      spdlog::error("{}", p.error().to_string());
+      return kExitRuntime;
+    }
+    pos = std::move(*p);
+  }
+
+  RoverSource source(std::move(*rover), config->pace, std::move(file_base), dds_base ? &base_frames : nullptr,
+                     config->base_wait_s);
+  std::uint64_t solved = 0, fixed = 0, epochs = 0;
+  std::atomic<std::uint64_t> refused{0};  // the time bridge's and the ambiguity stage's threads publish
+  const auto sink = [&](const app::EpochItem& item) -> Status {
+    ++epochs;
+    if (item.output) {
+      ++solved;
+      if (item.output->solution.status == core::SolutionStatus::Fixed) ++fixed;
+      if (pos) return pos->write(item.output->solution);
+    }
+    return canyon::Ok{};
+  };
+  app::EpochPipeline* pipeline_ptr = nullptr;
+  pl::EpochContext context;
+  context.rover_id = config->rover_id;
+  const auto observer = [&](app::Stage stage, const app::EpochItem& item) {
+    if (stage == app::Stage::TimeBridge && bridged_writer) {
+      auto m = pl::to_msg_bridged(item);
+      if (!bridged_writer->write(m)) ++refused;
+    }
+    if (stage != app::Stage::Ambiguity) return;
+    context.base_late = source.base_late();
+    context.vio_dropped = 0;
+    if (pipeline_ptr != nullptr) {
+      context.queue_depth = pipeline_ptr->queue_depths();
+      context.queue_full_waits = pipeline_ptr->stats().full_waits;
+    }
+    context.alignment_rmse_m = std::numeric_limits<double>::quiet_NaN();
+    if (item.output && item.output->alignment) {
+      context.alignment_rmse_m = item.output->alignment->rmse_m;
+      context.alignment_eigen_ratio = item.output->alignment->first_eigenvalue_ratio;
+      context.lever_arm_m = item.output->alignment->t_IA_m;
+    }
+    if (prior_writer) {
+      auto prior = pl::to_msg_prior(item);
+      if (!prior_writer->write(prior)) ++refused;
+      auto floating = pl::to_msg_float(item);
+      if (!float_writer->write(floating)) ++refused;
+    }
+    if (alignment_writer) {
+      auto alignment = pl::to_msg_alignment(item);
+      if (!alignment_writer->write(alignment)) ++refused;
+    }
+    auto solution = pl::to_msg_solution(item, context);
+    if (!(*solution_writer)->write(solution)) ++refused;
+    auto timing = pl::to_msg_timing(item, context);
+    if (!(*timing_writer)->write(timing)) ++refused;
+  };
+  app::EpochPipeline pipeline(source, *estimator, sink, config->pipeline, observer);
+  pipeline_ptr = &pipeline;
+  g_pipeline.store(&pipeline);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  if (wait_subscribers > 0) {
+    spdlog::info("waiting for {} solution subscriber(s) (at most {} s)", wait_subscribers, wait_timeout_s);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_timeout_s);
+    while ((*solution_writer)->matched() < wait_subscribers && std::chrono::steady_clock::now() < until &&
+           !g_stop.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if ((*solution_writer)->matched() < wait_subscribers) {
+      spdlog::warn("only {} of {} subscribers matched; starting anyway", (*solution_writer)->matched(),
+                   wait_subscribers);
+    }
+  }
+  spdlog::info("rover '{}': {} mode, base from {}, {} pipeline, pace {}; publishing {} and {} on domain {}",
+               config->rover_id, app::mode_name(est.mode), dds_base ? "DDS " + config->rtcm_topic : est.base_obs,
+               config->pipeline.threaded ? "threaded" : "sequential", config->pace, config->solution_topic,
+               config->timing_topic, config->domain);
+  const auto start = std::chrono::steady_clock::now();
+  Status status = pipeline.run();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  g_pipeline.store(nullptr);
+  if (pos) {
+    if (Status c = pos->close(); !c && status) status = c;
+  }
+  if (!(*solution_writer)->wait_for_acknowledgments(5.0) || !(*timing_writer)->wait_for_acknowledgments(5.0)) {
+    spdlog::warn("DDS: not every solution was acknowledged by every reader within 5 s");
+  }
+  if (refused.load() > 0) spdlog::warn("DDS: {} samples refused by the writers (history full)", refused.load());
+  if (base_frames_dropped.load() > 0 || base_frames_bad.load() > 0) {
+    spdlog::warn("base: {} RTCM frames dropped (queue full), {} malformed", base_frames_dropped.load(),
+                 base_frames_bad.load());
+  }
+  if (source.base_late() > 0) {
+    spdlog::warn("base: {} epochs went on without waiting longer for their base epoch (input.base_wait_s {})",
+                 source.base_late(), config->base_wait_s);
+  }
+  if (fusion_engine) {
+    for (const std::string& line : fusion_engine->report()) spdlog::info("{}", line);
+  }
+  const app::PipelineStats stats = pipeline.stats();
+  std::uint64_t waits = 0;
+  for (const auto w : stats.full_waits) waits += w;
+  spdlog::info("{} epochs, {} solved, {} fixed in {:.3f} s ({:.0f} epochs/s); queue-full waits {}{}", epochs, solved,
+               fixed, wall_s, wall_s > 0 ? static_cast<double>(epochs) / wall_s : 0.0, waits,
+               g_stop.load() ? " (stopped by signal)" : "");
+  if (!status.ok()) {
+    spdlog::error("{}", status.error().to_string());
+    return kExitRuntime;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "canyon-rover: internal error: " << e.what() << "\n";
+    return kExitRuntime;
+  }
+}

@@ -1,0 +1,306 @@
+// Rover pipeline messages (see rover_msgs.hpp).
+
+#include "canyon/pipeline/rover_msgs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/core/geodesy.hpp"
+
+namespace canyon::pipeline {
+namespace {
+
+constexpr std::size_t kMaxSatellites = 128;  // idl bound of the satellite lists
+constexpr std::size_t kMaxNote = 255;        // string<256>
+
+using SatName = eprosima::fastrtps::fixed_string<4>;
+
+std::vector<SatName> satellite_names(const std::vector<core::SatelliteId>& sats) {
+  std::vector<SatName> names;
+  for (const core::SatelliteId& s : sats) {
+    if (names.size() >= kMaxSatellites) break;
+    names.emplace_back(s.to_string());
+  }
+  return names;
+}
+
+std::array<double, 6> upper(const Eigen::Matrix3d& P) {
+  return {P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2)};
+}
+
+Eigen::Matrix3d from_upper(const std::array<double, 6>& u) {
+  Eigen::Matrix3d P;
+  P << u[0], u[1], u[2], u[1], u[3], u[4], u[2], u[4], u[5];
+  return P;
+}
+
+}  // namespace
+
+msg::StageStamps to_msg_stamps(const app::EpochItem& item) {
+  msg::StageStamps s;
+  s.arrival_monotonic_ns(item.arrival_ns);
+  s.base_send_monotonic_ns(item.base_send_ns);
+  std::array<std::int64_t, 6> enter{};
+  std::array<std::int64_t, 6> exit{};
+  for (std::size_t i = 0; i < app::kNumStages; ++i) {
+    enter[i] = item.enter_ns[i];
+    exit[i] = item.exit_ns[i];
+  }
+  s.enter_monotonic_ns(enter);
+  s.exit_monotonic_ns(exit);
+  return s;
+}
+
+msg::Solution to_msg_solution(const app::EpochItem& item, const EpochContext& context) {
+  msg::Solution m;
+  m.sequence_number(item.seq);
+  m.rover_id(context.rover_id);
+  const core::GpsTime t = item.output ? item.output->solution.time : item.rover.time;
+  m.gps_week(t.week);
+  m.gps_tow_s(t.tow_s);
+  if (item.output) {
+    const app::EpochOutput& o = *item.output;
+    const core::Solution& s = o.solution;
+    m.status(static_cast<std::uint8_t>(s.status));
+    m.p_E_m({s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z()});
+    m.covariance_E_m2(upper(s.P_E_m2));
+    if (s.v_E_mps) m.v_E_mps({s.v_E_mps->x(), s.v_E_mps->y(), s.v_E_mps->z()});
+    const core::Geodetic g = core::ecef_to_geodetic(s.p_E_m);
+    m.lat_deg(g.lat_rad * core::kRadToDeg);
+    m.lon_deg(g.lon_rad * core::kRadToDeg);
+    m.height_m(g.height_m);
+    m.num_satellites(static_cast<std::uint8_t>(std::clamp(s.num_satellites, 0, 255)));
+    m.ratio(s.ratio);
+    m.age_s(s.age_s);
+    m.hdop(o.hdop);
+    m.aided(o.aided);
+    m.pruned(satellite_names(o.ar_pruned));
+    m.rejected(satellite_names(o.rejected));
+    m.note(o.note.substr(0, kMaxNote));
+  } else {
+    m.status(0);
+    m.note(item.error ? item.error->message.substr(0, kMaxNote) : std::string("no solution"));
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& context) {
+  msg::StageTiming m;
+  m.sequence_number(item.seq);
+  m.rover_id(context.rover_id);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  m.stamps(to_msg_stamps(item));
+  m.correction_age_s(item.base ? item.rover.time - item.base->time : std::numeric_limits<double>::quiet_NaN());
+  std::array<std::uint32_t, 5> depth{};
+  std::array<std::uint64_t, 5> waits{};
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    depth[i] = static_cast<std::uint32_t>(context.queue_depth[i]);
+    waits[i] = context.queue_full_waits[i];
+  }
+  m.queue_depth(depth);
+  m.queue_full_waits(waits);
+  m.vio_dropped(context.vio_dropped);
+  m.base_late(context.base_late);
+  m.alignment_rmse_m(context.alignment_rmse_m);
+  m.alignment_eigen_ratio(context.alignment_eigen_ratio);
+  m.lever_arm_m({context.lever_arm_m.x(), context.lever_arm_m.y(), context.lever_arm_m.z()});
+  m.publish_monotonic_ns(core::pipeline_now_ns());
+  return m;
+}
+
+msg::BridgedEpoch to_msg_bridged(const app::EpochItem& item) {
+  msg::BridgedEpoch m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  m.valid(item.pose.has_value());
+  if (item.pose) {
+    m.vio_segment(item.pose->segment);
+    const Eigen::Vector3d& p = item.pose->T_OI.p;
+    const Eigen::Quaterniond& q = item.pose->T_OI.q;
+    m.p_O_m({p.x(), p.y(), p.z()});
+    m.q_OI_xyzw({q.x(), q.y(), q.z(), q.w()});
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+msg::Prior to_msg_prior(const app::EpochItem& item) {
+  msg::Prior m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  if (item.output && item.output->has_prior) {
+    const app::EpochOutput& o = *item.output;
+    m.aided(true);
+    m.p_E_m({o.prior_p_E_m.x(), o.prior_p_E_m.y(), o.prior_p_E_m.z()});
+    m.covariance_E_m2(upper(o.prior_P_E_m2));
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+msg::FloatSolution to_msg_float(const app::EpochItem& item) {
+  msg::FloatSolution m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  if (item.output && item.output->has_float) {
+    const app::EpochOutput& o = *item.output;
+    m.valid(true);
+    m.p_E_m({o.float_p_E_m.x(), o.float_p_E_m.y(), o.float_p_E_m.z()});
+    m.covariance_E_m2(upper(o.float_P_E_m2));
+    m.dd_phase_rows(o.dd_phase_rows);
+    m.dd_code_rows(o.dd_code_rows);
+    m.max_post_fit_normalised(o.max_post_fit_normalised);
+    m.rejected(satellite_names(o.rejected));
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+msg::Alignment to_msg_alignment(const app::EpochItem& item) {
+  msg::Alignment m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  m.kind("none");
+  if (item.output && item.output->alignment) {
+    const app::EpochOutput::Alignment& a = *item.output->alignment;
+    m.aligned(true);
+    m.kind(a.kind.substr(0, 15));
+    m.rmse_m(a.rmse_m);
+    m.first_eigenvalue_ratio(a.first_eigenvalue_ratio);
+    m.t_IA_m({a.t_IA_m.x(), a.t_IA_m.y(), a.t_IA_m.z()});
+  }
+  m.stamps(to_msg_stamps(item));
+  return m;
+}
+
+std::string describe(const msg::Prior& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "prior #%llu %d %.3f %s p_E [%.3f %.3f %.3f] sigma %.3f m",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(),
+                m.aided() ? "aided" : "not-aided", m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2],
+                std::sqrt(std::max(0.0, m.covariance_E_m2()[0] + m.covariance_E_m2()[3] + m.covariance_E_m2()[5])));
+  return line;
+}
+
+std::string describe(const msg::FloatSolution& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "float #%llu %d %.3f %s p_E [%.3f %.3f %.3f] DD phase %d code %d post-fit %.2f",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(),
+                m.valid() ? "valid" : "none", m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2], m.dd_phase_rows(),
+                m.dd_code_rows(), m.max_post_fit_normalised());
+  return line;
+}
+
+std::string describe(const msg::Alignment& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "alignment #%llu %d %.3f %s RMSE %.3f m FER %.3f t_IA [%.3f %.3f %.3f] m",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(), m.kind().c_str(),
+                m.rmse_m(), m.first_eigenvalue_ratio(), m.t_IA_m()[0], m.t_IA_m()[1], m.t_IA_m()[2]);
+  return line;
+}
+
+Result<core::Solution> from_msg(const msg::Solution& m) {
+  const std::string which = "Solution " + std::to_string(m.sequence_number());
+  const int status = m.status();
+  if (status != 0 && status != 1 && status != 2 && status != 5 && status != 7) {
+    return Error{which + ": status " + std::to_string(status) + " is not 0, 1, 2, 5 or 7"};
+  }
+  if (m.pruned().size() > kMaxSatellites || m.rejected().size() > kMaxSatellites || m.note().size() > kMaxNote) {
+    return Error{which + ": a list exceeds its IDL bound"};
+  }
+  core::Solution s;
+  s.time = core::GpsTime{m.gps_week(), m.gps_tow_s()};
+  s.status = static_cast<core::SolutionStatus>(status);
+  s.p_E_m = Eigen::Vector3d(m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2]);
+  s.P_E_m2 = from_upper(m.covariance_E_m2());
+  s.num_satellites = m.num_satellites();
+  s.age_s = m.age_s();
+  s.ratio = m.ratio();
+  if (status != 0 && (!s.p_E_m.allFinite() || !std::isfinite(m.gps_tow_s()))) return Error{which + ": not finite"};
+  return s;
+}
+
+app::SolutionSample to_sample(const msg::Solution& m, std::int64_t received_ns) {
+  app::SolutionSample s;
+  s.rover_id = m.rover_id().to_string();
+  s.seq = m.sequence_number();
+  s.status = m.status();
+  s.lat_deg = m.lat_deg();
+  s.lon_deg = m.lon_deg();
+  s.height_m = m.height_m();
+  s.n_sats = m.num_satellites();
+  s.ratio = m.ratio();
+  for (const auto& p : m.pruned()) s.pruned.push_back(p.to_string());
+  s.arrival_ns = m.stamps().arrival_monotonic_ns();
+  s.base_send_ns = m.stamps().base_send_monotonic_ns();
+  s.received_ns = received_ns;
+  return s;
+}
+
+app::TimingSample to_sample(const msg::StageTiming& m) {
+  app::TimingSample s;
+  s.rover_id = m.rover_id().to_string();
+  s.seq = m.sequence_number();
+  s.arrival_ns = m.stamps().arrival_monotonic_ns();
+  for (std::size_t i = 0; i < app::kMonitorStages; ++i) {
+    s.enter_ns[i] = m.stamps().enter_monotonic_ns()[i];
+    s.exit_ns[i] = m.stamps().exit_monotonic_ns()[i];
+  }
+  s.correction_age_s = m.correction_age_s();
+  for (std::size_t i = 0; i < app::kMonitorQueues; ++i) {
+    s.queue_depth[i] = m.queue_depth()[i];
+    s.queue_full_waits[i] = m.queue_full_waits()[i];
+  }
+  s.vio_dropped = m.vio_dropped();
+  s.base_late = m.base_late();
+  s.alignment_rmse_m = m.alignment_rmse_m();
+  s.alignment_eigen_ratio = m.alignment_eigen_ratio();
+  s.lever_arm_m = Eigen::Vector3d(m.lever_arm_m()[0], m.lever_arm_m()[1], m.lever_arm_m()[2]);
+  return s;
+}
+
+std::string describe(const msg::Solution& m) {
+  char line[512];
+  std::string pruned;
+  for (const auto& p : m.pruned()) pruned += " " + p.to_string();
+  std::snprintf(line, sizeof line, "solution #%llu %s %d %.3f Q%d %.9f %.9f %.4f ns %d ratio %.1f age %.1f%s%s%s",
+                static_cast<unsigned long long>(m.sequence_number()), m.rover_id().c_str(), m.gps_week(), m.gps_tow_s(),
+                m.status(), m.lat_deg(), m.lon_deg(), m.height_m(), m.num_satellites(), m.ratio(), m.age_s(),
+                pruned.empty() ? "" : " pruned", pruned.c_str(),
+                m.note().size() == 0 ? "" : (" (" + m.note().to_string() + ")").c_str());
+  return line;
+}
+
+std::string describe(const msg::StageTiming& m) {
+  std::string line = "timing #" + std::to_string(m.sequence_number()) + " " + m.rover_id().to_string() + " us:";
+  const char* names[] = {"ingest", "bridge", "align", "predict", "update", "ambiguity"};
+  for (std::size_t i = 0; i < 6; ++i) {
+    char part[48];
+    std::snprintf(part, sizeof part, " %s %.1f", names[i],
+                  static_cast<double>(m.stamps().exit_monotonic_ns()[i] - m.stamps().enter_monotonic_ns()[i]) * 1e-3);
+    line += part;
+  }
+  char tail[96];
+  std::snprintf(tail, sizeof tail, " end-to-end %.1f",
+                static_cast<double>(m.stamps().exit_monotonic_ns()[5] - m.stamps().arrival_monotonic_ns()) * 1e-3);
+  return line + tail;
+}
+
+std::string describe(const msg::BridgedEpoch& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "bridged #%llu %d %.3f %s segment %d p_O [%.3f %.3f %.3f]",
+                static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(),
+                m.valid() ? "pose" : "no-pose", m.vio_segment(), m.p_O_m()[0], m.p_O_m()[1], m.p_O_m()[2]);
+  return line;
+}
+
+}  // namespace canyon::pipeline

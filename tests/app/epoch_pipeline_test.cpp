@@ -1,0 +1,262 @@
+// The staged pipeline (app/epoch_pipeline.hpp):
+//  - threaded and sequential `canyon process` give the same .pos byte for byte: rtk on instinct-spirent-rtk-sim
+//    (shared data; skipped when absent) and fusion on a generated urban-severe scenario with VIO;
+//  - queues: a full queue blocks its producer (counted, nothing dropped, order kept); empty queues wait;
+//  - stop() with epochs in flight: every epoch ingested reaches the sink, run() returns cleanly;
+//  - a failing source or sink stops the pipeline with its error, without hanging.
+
+#include "canyon/app/epoch_pipeline.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "canyon/app/process.hpp"
+#include "canyon/app/process_config.hpp"
+#include "canyon/app/scenario_config.hpp"
+#include "canyon/app/simulate.hpp"
+
+namespace canyon::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path temp_dir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("canyon_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// The report without its CPU-time figures (they differ from run to run).
+std::vector<std::string> without_cpu_times(std::vector<std::string> lines) {
+  const std::regex cpu("[0-9.]+ s CPU");
+  for (std::string& line : lines) line = std::regex_replace(line, cpu, "_ s CPU");
+  return lines;
+}
+
+/// Runs `config` sequentially and threaded; returns both .pos files' contents.
+std::pair<std::string, std::string> both_ways(ProcessConfig config, const fs::path& dir) {
+  config.out = (dir / "sequential.pos").string();
+  auto seq = run_process(config, {}, PipelineOptions{false, 64});
+  EXPECT_TRUE(seq) << (seq ? "" : seq.error().to_string());
+  config.out = (dir / "threaded.pos").string();
+  auto thr = run_process(config, {}, PipelineOptions{true, 4});
+  EXPECT_TRUE(thr) << (thr ? "" : thr.error().to_string());
+  if (seq && thr) {
+    EXPECT_EQ(seq->epochs, thr->epochs);
+    EXPECT_EQ(seq->fixed, thr->fixed);
+    EXPECT_EQ(without_cpu_times(seq->report), without_cpu_times(thr->report));
+  }
+  return {slurp(dir / "sequential.pos"), slurp(dir / "threaded.pos")};
+}
+
+TEST(EpochPipeline, ThreadedEqualsSequentialRtkInstinct) {
+  const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "instinct-spirent-rtk-sim";
+  if (!fs::exists(data)) GTEST_SKIP() << "shared data absent: " << data;
+  const fs::path dir = temp_dir("pipeline-rtk");
+  auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/rtk.yaml");
+  ASSERT_TRUE(config);
+  config->rover_obs = (data / "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs").string();
+  config->base_obs = (data / "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs").string();
+  config->nav = {(data / "RINEX_GN_Spirent.23N").string()};
+  const auto [seq, thr] = both_ways(*config, dir);
+  EXPECT_GT(seq.size(), 10000U);
+  EXPECT_TRUE(seq == thr) << "threaded .pos differs from sequential";
+}
+
+TEST(EpochPipeline, ThreadedEqualsSequentialFusionUrbanSevere) {
+  const fs::path dir = temp_dir("pipeline-fusion");
+  auto scenario = load_scenario(std::string(CANYON_SOURCE_DIR) + "/config/scenarios/urban-severe.yaml");
+  ASSERT_TRUE(scenario) << scenario.error().to_string();
+  scenario->duration_s = 60.0;
+  auto sim = run_simulate(*scenario, dir.string());
+  ASSERT_TRUE(sim) << sim.error().to_string();
+  auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/fusion.yaml");
+  ASSERT_TRUE(config);
+  config->rover_obs = (dir / "rover.obs").string();
+  config->base_obs = (dir / "base.obs").string();
+  config->nav = {(dir / "nav.rnx").string()};
+  config->vio = (dir / "vio.csv").string();
+  config->timesync = (dir / "timesync.csv").string();
+  const auto [seq, thr] = both_ways(*config, dir);
+  EXPECT_GT(seq.size(), 10000U);
+  EXPECT_TRUE(seq == thr) << "threaded .pos differs from sequential";
+}
+
+// ---- Queues and shutdown, with a fake source and estimator ----
+
+core::ObsEpoch epoch_at(double tow_s) {
+  core::ObsEpoch e;
+  e.time = core::GpsTime{2300, tow_s};
+  return e;
+}
+
+/// `n` epochs (or endless with n < 0), each after `delay`.
+class CountingSource final : public EpochSource {
+ public:
+  CountingSource(int n, std::chrono::microseconds delay) : n_(n), delay_(delay) {}
+  Result<std::optional<EpochItem>> next() override {
+    if (n_ >= 0 && produced_.load() >= n_) return std::optional<EpochItem>{};
+    if (fail_at_ >= 0 && produced_.load() == fail_at_) return Error{"source broke"};
+    std::this_thread::sleep_for(delay_);
+    std::optional<EpochItem> item(std::in_place);
+    item->rover = epoch_at(produced_.load());
+    produced_.fetch_add(1);
+    return item;
+  }
+  std::atomic<int> produced_{0};
+  int fail_at_ = -1;
+
+ private:
+  int n_;
+  std::chrono::microseconds delay_;
+};
+
+/// Records the order in which each stage saw epochs; resolve() makes the output.
+class RecordingEstimator final : public EpochEstimator {
+ public:
+  void bridge(EpochItem& item) const override { (void)item; }
+  void align(EpochItem& item) override { check(item, in_align_); }
+  void predict(EpochItem& item) override {
+    check(item, in_predict_);
+    item.to_update = true;
+  }
+  void update(EpochItem& item) override { item.to_resolve = true; }
+  void resolve(EpochItem& item) override {
+    // The token: alignment of epoch k+1 never runs before the ambiguity stage finished epoch k.
+    EXPECT_EQ(busy_.exchange(false), true);
+    EpochOutput out;
+    out.solution.time = item.rover.time;
+    out.solution.status = core::SolutionStatus::Fixed;
+    item.output = out;
+  }
+  void finish() override { finished = true; }
+  bool finished = false;
+
+ private:
+  void check(const EpochItem& item, std::uint64_t& next) {
+    EXPECT_EQ(item.seq, next);
+    ++next;
+    if (&next == &in_align_) EXPECT_EQ(busy_.exchange(true), false);
+  }
+  std::uint64_t in_align_ = 0, in_predict_ = 0;
+  std::atomic<bool> busy_{false};
+};
+
+TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
+  CountingSource source(200, std::chrono::microseconds(0));
+  RecordingEstimator estimator;
+  std::vector<double> seen;
+  const auto slow_sink = [&seen](const EpochItem& item) -> Status {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    seen.push_back(item.output->solution.time.tow_s);
+    return Ok{};
+  };
+  EpochPipeline pipeline(source, estimator, slow_sink, PipelineOptions{true, 1});
+  ASSERT_TRUE(pipeline.run().ok());
+  ASSERT_EQ(seen.size(), 200U);
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<double>(i));
+  const PipelineStats stats = pipeline.stats();
+  EXPECT_EQ(stats.epochs, 200U);
+  EXPECT_GT(stats.full_waits[0], 0U) << "ingest never found its queue full";
+  EXPECT_TRUE(estimator.finished);
+  for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
+}
+
+TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
+  CountingSource source(20, std::chrono::milliseconds(2));
+  RecordingEstimator estimator;
+  int sunk = 0;
+  EpochPipeline pipeline(
+      source, estimator,
+      [&sunk](const EpochItem& item) -> Status {
+        EXPECT_TRUE(item.output.has_value());
+        // Every stage stamped the epoch, in order, after its arrival.
+        for (std::size_t s = 0; s < kNumStages; ++s) {
+          EXPECT_LE(item.enter_ns[s], item.exit_ns[s]);
+          if (s > 0) EXPECT_LE(item.exit_ns[s - 1], item.enter_ns[s]);
+        }
+        EXPECT_LE(item.arrival_ns, item.exit_ns[kNumStages - 1]);
+        ++sunk;
+        return Ok{};
+      },
+      PipelineOptions{true, 8});
+  ASSERT_TRUE(pipeline.run().ok());
+  EXPECT_EQ(sunk, 20);
+  for (const auto w : pipeline.stats().full_waits) EXPECT_EQ(w, 0U);
+}
+
+TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {
+  CountingSource source(-1, std::chrono::microseconds(50));  // endless
+  RecordingEstimator estimator;
+  std::atomic<int> sunk{0};
+  EpochPipeline* self = nullptr;
+  EpochPipeline pipeline(
+      source, estimator,
+      [&sunk, &self](const EpochItem& /*item*/) -> Status {
+        std::this_thread::sleep_for(std::chrono::microseconds(300));  // the queues fill up behind
+        if (sunk.fetch_add(1) == 50) self->stop();
+        return Ok{};
+      },
+      PipelineOptions{true, 16});
+  self = &pipeline;
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(pipeline.run().ok());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  EXPECT_GT(sunk.load(), 51) << "the epochs in the queues were not finished";
+  EXPECT_EQ(sunk.load(), source.produced_.load()) << "an ingested epoch was lost at shutdown";
+  EXPECT_TRUE(estimator.finished);
+}
+
+TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {
+  for (const bool threaded : {false, true}) {
+    CountingSource source(1000, std::chrono::microseconds(0));
+    source.fail_at_ = 30;
+    RecordingEstimator estimator;
+    EpochPipeline pipeline(
+        source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, PipelineOptions{threaded, 4});
+    const Status s = pipeline.run();
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().message, "source broke");
+  }
+  for (const bool threaded : {false, true}) {
+    CountingSource source(1000, std::chrono::microseconds(0));
+    RecordingEstimator estimator;
+    int sunk = 0;
+    EpochPipeline pipeline(
+        source, estimator,
+        [&sunk](const EpochItem&) -> Status {
+          if (++sunk == 10) return Error{"disk full", "out.pos", 0};
+          return Ok{};
+        },
+        PipelineOptions{threaded, 4});
+    const Status s = pipeline.run();
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().message, "disk full");
+    EXPECT_LT(source.produced_.load(), 1000);
+  }
+  CountingSource source(1, std::chrono::microseconds(0));
+  RecordingEstimator estimator;
+  EpochPipeline bad(
+      source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, PipelineOptions{true, 0});
+  const Status s = bad.run();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("queue_capacity"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace canyon::app
