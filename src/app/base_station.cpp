@@ -208,7 +208,10 @@ bool BaseStation::wait_for_clients(int clients, double timeout_s) {
   const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
   while (!stop_requested()) {
     drain_server_events();
-    if (subscribers() >= clients) return true;
+    if (subscribers() >= clients) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(kSettleS));
+      return !stop_requested();
+    }
     if (Clock::now() > end) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

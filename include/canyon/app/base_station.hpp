@@ -63,8 +63,11 @@ class BaseStation {
   /// Counts subscribers of outputs that are not sockets (DDS readers), for wait_for_clients.
   void set_subscriber_count(std::function<int()> count);
   /// Waits until `clients` subscribers (NTRIP + TCP clients + set_subscriber_count()) are there, at most
-  /// `timeout_s`; false on timeout or stop().
+  /// `timeout_s`, then kSettleS more: a DDS writer counts a reader as matched before the reader has matched the
+  /// writer, and on a loaded machine the first frames of a volatile stream could otherwise miss it. False on timeout
+  /// or stop().
   bool wait_for_clients(int clients, double timeout_s);
+  static constexpr double kSettleS = 0.5;
   /// Runs until a file input ends, stop(), or a fatal input error (returned).
   Status run();
   /// Asks run() to return (thread-safe; async-signal-safe: it only sets a flag).
