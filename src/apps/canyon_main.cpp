@@ -8,6 +8,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <malloc.h>
@@ -108,6 +109,18 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   cmd->add_flag("-v,--verbose", args.verbose, "Log why epochs got no solution or, in rtk mode, no fix (first 100)");
 }
 
+/// Input defects are often repeated every epoch: the first few warnings, and a count of the rest ("... and N
+/// `rest`"), unless `verbose`.
+void print_warnings(const std::vector<std::string>& warnings, bool verbose, const char* rest) {
+  constexpr std::size_t kMaxWarningsShown = 5;
+  for (std::size_t i = 0; i < warnings.size() && (verbose || i < kMaxWarningsShown); ++i) {
+    std::fprintf(stderr, "canyon: warning: %s\n", warnings[i].c_str());
+  }
+  if (!verbose && warnings.size() > kMaxWarningsShown) {
+    std::fprintf(stderr, "canyon: warning: ... and %zu %s (-v shows all)\n", warnings.size() - kMaxWarningsShown, rest);
+  }
+}
+
 int run_process_command(const ProcessArgs& args) {
   using canyon::app::ProcessConfig;
   ProcessConfig config;
@@ -185,15 +198,7 @@ int run_process_command(const ProcessArgs& args) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
   }
-  // Input defects are often repeated every epoch: show the first few and count the rest.
-  constexpr std::size_t kMaxWarningsShown = 5;
-  for (std::size_t i = 0; i < summary->warnings.size() && (args.verbose || i < kMaxWarningsShown); ++i) {
-    std::fprintf(stderr, "canyon: warning: %s\n", summary->warnings[i].c_str());
-  }
-  if (!args.verbose && summary->warnings.size() > kMaxWarningsShown) {
-    std::fprintf(stderr, "canyon: warning: ... and %zu more input warnings (-v shows all)\n",
-                 summary->warnings.size() - kMaxWarningsShown);
-  }
+  print_warnings(summary->warnings, args.verbose, "more input warnings");
   if (!summary->excluded_most_observed.empty() && !args.quiet) {
     std::string sats;
     for (const auto& sat : summary->excluded_most_observed) {
@@ -511,14 +516,7 @@ int run_convert_command(ConvertArgs& args) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
   }
-  constexpr std::size_t kMaxWarningsShown = 5;
-  for (std::size_t i = 0; i < summary->warnings.size() && (args.verbose || i < kMaxWarningsShown); ++i) {
-    std::fprintf(stderr, "canyon: warning: %s\n", summary->warnings[i].c_str());
-  }
-  if (!args.verbose && summary->warnings.size() > kMaxWarningsShown) {
-    std::fprintf(stderr, "canyon: warning: ... and %zu more (-v shows all)\n",
-                 summary->warnings.size() - kMaxWarningsShown);
-  }
+  print_warnings(summary->warnings, args.verbose, "more");
   if (!args.quiet) {
     std::fprintf(stderr, "canyon convert: %s: %d epochs, %d ephemerides; %s\n", summary->direction.c_str(),
                  summary->epochs, summary->ephemerides, summary->statistics.c_str());

@@ -329,13 +329,17 @@ int run(int argc, char** argv) {
     const std::lock_guard lock(mutex);
     const std::int64_t now = canyon::core::pipeline_now_ns();
 #ifdef CANYON_WITH_DASHBOARD
-    if (dashboard) (void)dashboard->push(model.json_line(now));  // a snapshot the model made cannot be a bad line
+    // One snapshot for the terminal (--json) and the dashboard alike; the model makes only valid lines.
+    const std::string line = (json || dashboard) ? model.json_line(now) : std::string();
+    if (dashboard) (void)dashboard->push(line);
+#else
+    const std::string line = json ? model.json_line(now) : std::string();
 #endif
     if (json) {
-      std::printf("%s\n", model.json_line(now).c_str());
+      std::printf("%s\n", line.c_str());
     } else {
       std::printf("\033[H\033[2J");
-      for (const std::string& line : model.text(now)) std::printf("%s\n", line.c_str());
+      for (const std::string& row : model.text(now)) std::printf("%s\n", row.c_str());
     }
     std::fflush(stdout);
   };

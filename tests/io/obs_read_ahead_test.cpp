@@ -31,7 +31,21 @@ struct Reading {
   std::string error;
 };
 
-/// RinexObsReader::next() in a loop, stopping after `max_epochs`.
+/// next() in a loop over an opened reader (RinexObsReader or ObsReadAhead), stopping after `max_epochs`.
+template <typename Reader>
+void read_epochs(Reader& reader, std::size_t max_epochs, Reading& out) {
+  while (out.epochs.size() < max_epochs) {
+    auto epoch = reader.next();
+    if (!epoch) {
+      out.error = epoch.error().message;
+      break;
+    }
+    if (!*epoch) break;
+    out.epochs.push_back(std::move(**epoch));
+    out.fractions.push_back(reader.fraction_read());
+  }
+}
+
 Reading read_sequentially(const std::string& path, std::size_t max_epochs = SIZE_MAX) {
   Reading out;
   auto reader = RinexObsReader::open(path);
@@ -39,16 +53,7 @@ Reading read_sequentially(const std::string& path, std::size_t max_epochs = SIZE
     out.error = reader.error().message;
     return out;
   }
-  while (out.epochs.size() < max_epochs) {
-    auto epoch = reader->next();
-    if (!epoch) {
-      out.error = epoch.error().message;
-      break;
-    }
-    if (!*epoch) break;
-    out.epochs.push_back(std::move(**epoch));
-    out.fractions.push_back(reader->fraction_read());
-  }
+  read_epochs(*reader, max_epochs, out);
   out.warnings = reader->warnings();
   return out;
 }
@@ -60,16 +65,7 @@ Reading read_ahead(const std::string& path, std::size_t depth, std::size_t max_e
     out.error = reader.error().message;
     return out;
   }
-  while (out.epochs.size() < max_epochs) {
-    auto epoch = reader->next();
-    if (!epoch) {
-      out.error = epoch.error().message;
-      break;
-    }
-    if (!*epoch) break;
-    out.epochs.push_back(std::move(**epoch));
-    out.fractions.push_back(reader->fraction_read());
-  }
+  read_epochs(*reader, max_epochs, out);
   out.warnings = reader->finish();
   return out;
 }
