@@ -44,9 +44,13 @@ std::int64_t monotonic_ns() {
 
 // ---- Estimators: the engines' stages ----
 
+void RtkEstimator::bridge(EpochItem& item) const {
+  item.geometry.emplace(geometry_.build(item.rover, item.base ? &*item.base : nullptr));
+}
+
 void RtkEstimator::predict(EpochItem& item) {
   const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
-  auto more = engine_.predict(item.rover, base);
+  auto more = engine_.predict(item.rover, base, nullptr, item.geometry ? &*item.geometry : nullptr);
   if (!more) {
     item.error = more.error();
     return;
@@ -194,22 +198,67 @@ Status EpochPipeline::run() {
   return Ok{};
 }
 
+void EpochPipeline::ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns) {
+  item.seq = seq;
+  if (item.arrival_ns == 0) item.arrival_ns = enter_ns;
+  item.enter_ns[0] = item.arrival_ns;
+  item.exit_ns[0] = monotonic_ns();
+  if (observer_) observer_(Stage::Ingest, item);
+}
+
 Status EpochPipeline::run_sequential() {
+  if (options_.read_ahead) return run_read_ahead();
   for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
     const std::int64_t enter = monotonic_ns();
     auto next = source_.next();
     if (!next) return next.error();
     if (!*next) break;
     EpochItem& item = **next;
-    item.seq = seq;
-    if (item.arrival_ns == 0) item.arrival_ns = enter;
-    item.enter_ns[0] = item.arrival_ns;
-    item.exit_ns[0] = monotonic_ns();
-    if (observer_) observer_(Stage::Ingest, item);
+    ingested(item, seq, enter);
     for (std::size_t s = 1; s < kNumStages; ++s) run_stage(static_cast<Stage>(s), item);
     ++epochs_;
     if (Status w = sink_(item); !w) return w;
   }
+  estimator_.finish();
+  return Ok{};
+}
+
+Status EpochPipeline::run_read_ahead() {
+  ItemQueue ahead(options_.queue_capacity);
+  std::thread reader([this, &ahead] {
+    for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
+      const std::int64_t enter = monotonic_ns();
+      auto next = source_.next();
+      if (!next) {
+        fail(next.error());
+        break;
+      }
+      if (!*next) break;
+      auto item = std::make_unique<EpochItem>(std::move(**next));
+      ingested(*item, seq, enter);
+      run_stage(Stage::TimeBridge, *item);
+      if (!ahead.try_enqueue(std::move(item))) {
+        ++full_waits_[0];
+        ahead.wait_enqueue(std::move(item));  // never drops: back-pressure
+      }
+    }
+    ahead.wait_enqueue(nullptr);
+  });
+  // The estimator's stages and the sink on this thread; after an error (fail() stops the reader) the epochs already
+  // read are drained without the sink.
+  for (;;) {
+    ItemPtr item;
+    ahead.wait_dequeue(item);
+    if (!item) break;
+    for (std::size_t s = static_cast<std::size_t>(Stage::Alignment); s < kNumStages; ++s) {
+      run_stage(static_cast<Stage>(s), *item);
+    }
+    ++epochs_;
+    if (!failed_.load()) {
+      if (Status w = sink_(*item); !w) fail(w.error());
+    }
+  }
+  reader.join();
   estimator_.finish();
   return Ok{};
 }
@@ -234,11 +283,7 @@ Status EpochPipeline::run_threaded() {
       }
       if (!*next) break;
       auto item = std::make_unique<EpochItem>(std::move(**next));
-      item->seq = seq;
-      if (item->arrival_ns == 0) item->arrival_ns = enter;
-      item->enter_ns[0] = item->arrival_ns;
-      item->exit_ns[0] = monotonic_ns();
-      if (observer_) observer_(Stage::Ingest, *item);
+      ingested(*item, seq, enter);
       push(0, std::move(item));
     }
     push(0, nullptr);

@@ -24,52 +24,11 @@ using core::SatelliteId;
 constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
 constexpr std::size_t kPrunedSubsets = 3;    // partial fixing prunes at most this many group-excluded subsets
 
-/// Zero-difference model of one satellite seen from one receiver.
-struct ZeroDiff {
-  bool valid = false;
-  double model_m = 0.0;                             // rho (Sagnac) - c dts + troposphere
-  Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  // unit vector receiver -> satellite
-  double elevation_rad = 0.0;
-};
-
-/// A receiver's position with its geodetic coordinates and ENU rotation, for the zero differences of an epoch.
-struct ReceiverGeometry {
-  Eigen::Vector3d p_E_m;
-  core::Geodetic g;
-  Eigen::Matrix3d R_NE;
-
-  explicit ReceiverGeometry(const Eigen::Vector3d& p_E)
-      : p_E_m(p_E), g(core::ecef_to_geodetic(p_E)), R_NE(core::rotation_enu_from_ecef(g)) {}
-};
-
-ZeroDiff zero_difference(gnss::EpochSatelliteStates& states, const SatelliteId sat, double pseudorange_m,
-                         const ReceiverGeometry& receiver, bool troposphere) {
-  ZeroDiff z;
-  const auto state = states.at_reception(sat, pseudorange_m, false);
-  if (!state) return z;
-  const double range_m = gnss::geometric_range_m(state->p_E_m, receiver.p_E_m, &z.los_E);
-  z.elevation_rad = core::elevation_rad(receiver.p_E_m, receiver.g, receiver.R_NE, state->p_E_m);
-  z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s +
-              (troposphere ? gnss::saastamoinen_delay_m(receiver.g, z.elevation_rad) : 0.0);
-  z.valid = true;
-  return z;
-}
-
 /// Wavelength of a satellite's first frequency (rank 0), the reference of the ionosphere state.
 double first_wavelength_m(const gnss::EphemerisStore& eph, SatelliteId sat) {
   const char band = sat.system == Constellation::BeiDou ? '2' : '1';
   const int channel = sat.system == Constellation::Glonass ? eph.glonass_channel(sat.prn) : core::kNoGlonassChannel;
   return core::wavelength_m(sat.system, core::SignalCode{band, 'C'}, channel).value_or(0.19029367279836487);
-}
-
-/// Pseudorange of a satellite for the transmission-time computation: the first frequency that has one.
-double any_pseudorange(const ReceiverObservables& obs, SatelliteId sat) {
-  for (int f = 0; f < kMaxFrequencies; ++f) {
-    if (const SignalObservable* s = obs.find(sat, f); s != nullptr && core::has_value(s->pseudorange_m)) {
-      return s->pseudorange_m;
-    }
-  }
-  return core::kNoValue;
 }
 
 /// Zero-difference carrier-phase variance (m^2) of a signal at `elevation_rad` with C/N0 `snr_dbhz` (NaN: unknown):
@@ -394,10 +353,15 @@ RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides
     : options_(std::move(options)),
       eph_(ephemerides),
       p_E_base_m_(std::move(p_E_base_m)),
+      geometry_builder_(geometry_options(), eph_, p_E_base_m_),
       rover_slips_(options_.slips),
       base_slips_(options_.slips) {
   x_ = Eigen::VectorXd::Zero(num_kinematic_states());
   P_ = Eigen::MatrixXd::Zero(num_kinematic_states(), num_kinematic_states());
+}
+
+EpochGeometryBuilder::Options RtkEngine::geometry_options() const {
+  return {options_.spp, options_.observables, options_.troposphere_saastamoinen};
 }
 
 int RtkEngine::ambiguity_index(const AmbiguityKey& key) const {
@@ -1117,20 +1081,21 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   return take_epoch();
 }
 
-Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding) {
-  // The rover's satellite states are computed once, for the single-point solution, and reused by the zero
-  // differences.
+Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding,
+                                EpochGeometry* geometry) {
+  // The epoch's geometry (single-point solution, observables, satellite states): built ahead by the caller, or here.
+  std::optional<EpochGeometry> own_geometry;
+  if (geometry == nullptr) geometry = &own_geometry.emplace(geometry_builder_.build(rover, base));
+  assert(geometry->has_base == (base != nullptr));
   has_prior_ = false;
   if (aiding != nullptr && !initialised_) aiding = nullptr;  // nothing to add the increment to yet
-  gnss::EpochSatelliteStates rover_states(eph_, rover.time);
-  auto spp = gnss::solve_spp(rover, eph_, options_.spp, last_spp_p_E_m_, &rover_states);
+  const Result<gnss::SppSolution>& spp = geometry->spp;
   if (!spp && aiding == nullptr) return spp.error();
 
   pending_ = std::make_unique<PendingEpoch>();
   RtkEpoch& out = pending_->out;
   core::Solution& sol = out.solution;
   if (spp) {
-    last_spp_p_E_m_ = spp->p_E_m;
     sol.time = spp->time;
     sol.status = core::SolutionStatus::Single;
     sol.p_E_m = spp->p_E_m;
@@ -1164,10 +1129,8 @@ Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoc
   } else {
     time_update(rover.time, *spp);
   }
-  const ReceiverObservables rover_obs = select_observables(rover, eph_, options_.observables);
-  const ReceiverObservables base_obs = select_observables(*base, eph_, options_.observables);
-  detect_slips(rover_obs, base_obs);
-  pending_->sds = single_differences(rover_obs, base_obs, rover_states);
+  detect_slips(geometry->rover_obs, geometry->base_obs);
+  pending_->sds = single_differences(*geometry);
   update_ambiguities(pending_->sds, rover.time);
   if (aiding != nullptr) {
     out.aided = true;
@@ -1235,13 +1198,11 @@ RtkEpoch RtkEngine::take_epoch() {
   return out;
 }
 
-std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables& rover_obs,
-                                                      const ReceiverObservables& base_obs,
-                                                      gnss::EpochSatelliteStates& rover_states) const {
+std::vector<SingleDiff> RtkEngine::single_differences(EpochGeometry& geometry) const {
+  const ReceiverObservables& rover_obs = geometry.rover_obs;
+  const ReceiverObservables& base_obs = geometry.base_obs;
   const ReceiverGeometry rover(x_.head<3>());
-  const ReceiverGeometry base(p_E_base_m_);
   const bool tropo = options_.troposphere_saastamoinen;
-  gnss::EpochSatelliteStates base_states(eph_, base_obs.time);
   std::vector<SingleDiff> sds;
   sds.reserve(rover_obs.signals.size());
   SatelliteId current{};
@@ -1254,9 +1215,8 @@ std::vector<SingleDiff> RtkEngine::single_differences(const ReceiverObservables&
       // Each receiver's geometry at its own transmission time (its own time tag and pseudorange).
       current = r.sat;
       const double pr_r = any_pseudorange(rover_obs, r.sat);
-      const double pr_b = any_pseudorange(base_obs, r.sat);
-      zr = core::has_value(pr_r) ? zero_difference(rover_states, r.sat, pr_r, rover, tropo) : ZeroDiff{};
-      zb = core::has_value(pr_b) ? zero_difference(base_states, r.sat, pr_b, base, tropo) : ZeroDiff{};
+      zr = core::has_value(pr_r) ? zero_difference(geometry.rover_states, r.sat, pr_r, rover, tropo) : ZeroDiff{};
+      zb = geometry.base_model(r.sat);
     }
     if (!zr.valid || !zb.valid || zr.elevation_rad < options_.elevation_mask_rad) continue;
     SingleDiff sd;

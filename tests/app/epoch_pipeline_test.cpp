@@ -48,23 +48,39 @@ std::vector<std::string> without_cpu_times(std::vector<std::string> lines) {
   return lines;
 }
 
-/// Runs `config` sequentially and threaded; returns both .pos files' contents.
-std::pair<std::string, std::string> both_ways(ProcessConfig config, const fs::path& dir) {
-  config.out = (dir / "sequential.pos").string();
-  auto seq = run_process(config, {}, PipelineOptions{false, 64});
-  EXPECT_TRUE(seq) << (seq ? "" : seq.error().to_string());
-  config.out = (dir / "threaded.pos").string();
-  auto thr = run_process(config, {}, PipelineOptions{true, 4});
-  EXPECT_TRUE(thr) << (thr ? "" : thr.error().to_string());
-  if (seq && thr) {
-    EXPECT_EQ(seq->epochs, thr->epochs);
-    EXPECT_EQ(seq->fixed, thr->fixed);
-    EXPECT_EQ(without_cpu_times(seq->report), without_cpu_times(thr->report));
-  }
-  return {slurp(dir / "sequential.pos"), slurp(dir / "threaded.pos")};
+/// The three layouts: one thread, read-ahead (two threads), six threads.
+const std::vector<std::pair<std::string, PipelineOptions>>& layouts() {
+  static const std::vector<std::pair<std::string, PipelineOptions>> all{
+      {"sequential", PipelineOptions{false, 64}},
+      {"read-ahead", PipelineOptions{false, 4, true}},
+      {"threaded", PipelineOptions{true, 4}},
+  };
+  return all;
 }
 
-TEST(EpochPipeline, ThreadedEqualsSequentialRtkInstinct) {
+/// Runs `config` in every layout; returns the sequential .pos file's contents and the other two (read-ahead,
+/// threaded) after checking that their counts and reports equal the sequential run's.
+std::pair<std::string, std::vector<std::string>> every_way(ProcessConfig config, const fs::path& dir) {
+  std::optional<ProcessSummary> sequential;
+  std::vector<std::string> others;
+  for (const auto& [name, options] : layouts()) {
+    config.out = (dir / (name + ".pos")).string();
+    auto run = run_process(config, {}, options);
+    EXPECT_TRUE(run) << name << ": " << (run ? "" : run.error().to_string());
+    if (!run) continue;
+    if (!sequential) {
+      sequential = *run;
+      continue;
+    }
+    EXPECT_EQ(sequential->epochs, run->epochs) << name;
+    EXPECT_EQ(sequential->fixed, run->fixed) << name;
+    EXPECT_EQ(without_cpu_times(sequential->report), without_cpu_times(run->report)) << name;
+    others.push_back(slurp(config.out));
+  }
+  return {slurp(dir / "sequential.pos"), others};
+}
+
+TEST(EpochPipeline, EveryLayoutEqualsSequentialRtkInstinct) {
   const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "instinct-spirent-rtk-sim";
   if (!fs::exists(data)) GTEST_SKIP() << "shared data absent: " << data;
   const fs::path dir = temp_dir("pipeline-rtk");
@@ -73,12 +89,14 @@ TEST(EpochPipeline, ThreadedEqualsSequentialRtkInstinct) {
   config->rover_obs = (data / "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs").string();
   config->base_obs = (data / "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs").string();
   config->nav = {(data / "RINEX_GN_Spirent.23N").string()};
-  const auto [seq, thr] = both_ways(*config, dir);
+  const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  EXPECT_TRUE(seq == thr) << "threaded .pos differs from sequential";
+  ASSERT_EQ(others.size(), 2U);
+  EXPECT_TRUE(seq == others[0]) << "read-ahead .pos differs from sequential";
+  EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
 }
 
-TEST(EpochPipeline, ThreadedEqualsSequentialFusionUrbanSevere) {
+TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
   const fs::path dir = temp_dir("pipeline-fusion");
   auto scenario = load_scenario(std::string(CANYON_SOURCE_DIR) + "/config/scenarios/urban-severe.yaml");
   ASSERT_TRUE(scenario) << scenario.error().to_string();
@@ -92,9 +110,11 @@ TEST(EpochPipeline, ThreadedEqualsSequentialFusionUrbanSevere) {
   config->nav = {(dir / "nav.rnx").string()};
   config->vio = (dir / "vio.csv").string();
   config->timesync = (dir / "timesync.csv").string();
-  const auto [seq, thr] = both_ways(*config, dir);
+  const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  EXPECT_TRUE(seq == thr) << "threaded .pos differs from sequential";
+  ASSERT_EQ(others.size(), 2U);
+  EXPECT_TRUE(seq == others[0]) << "read-ahead .pos differs from sequential";
+  EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
 }
 
 // ---- Queues and shutdown, with a fake source and estimator ----
@@ -158,23 +178,26 @@ class RecordingEstimator final : public EpochEstimator {
 };
 
 TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
-  CountingSource source(200, std::chrono::microseconds(0));
-  RecordingEstimator estimator;
-  std::vector<double> seen;
-  const auto slow_sink = [&seen](const EpochItem& item) -> Status {
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-    seen.push_back(item.output->solution.time.tow_s);
-    return Ok{};
-  };
-  EpochPipeline pipeline(source, estimator, slow_sink, PipelineOptions{true, 1});
-  ASSERT_TRUE(pipeline.run().ok());
-  ASSERT_EQ(seen.size(), 200U);
-  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<double>(i));
-  const PipelineStats stats = pipeline.stats();
-  EXPECT_EQ(stats.epochs, 200U);
-  EXPECT_GT(stats.full_waits[0], 0U) << "ingest never found its queue full";
-  EXPECT_TRUE(estimator.finished);
-  for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
+  for (const PipelineOptions options : {PipelineOptions{true, 1}, PipelineOptions{false, 1, true}}) {
+    SCOPED_TRACE(options.threaded ? "threaded" : "read-ahead");
+    CountingSource source(200, std::chrono::microseconds(0));
+    RecordingEstimator estimator;
+    std::vector<double> seen;
+    const auto slow_sink = [&seen](const EpochItem& item) -> Status {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      seen.push_back(item.output->solution.time.tow_s);
+      return Ok{};
+    };
+    EpochPipeline pipeline(source, estimator, slow_sink, options);
+    ASSERT_TRUE(pipeline.run().ok());
+    ASSERT_EQ(seen.size(), 200U);
+    for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<double>(i));
+    const PipelineStats stats = pipeline.stats();
+    EXPECT_EQ(stats.epochs, 200U);
+    EXPECT_GT(stats.full_waits[0], 0U) << "ingest never found its queue full";
+    EXPECT_TRUE(estimator.finished);
+    for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
+  }
 }
 
 TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
@@ -201,39 +224,42 @@ TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
 }
 
 TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {
-  CountingSource source(-1, std::chrono::microseconds(50));  // endless
-  RecordingEstimator estimator;
-  std::atomic<int> sunk{0};
-  EpochPipeline* self = nullptr;
-  EpochPipeline pipeline(
-      source, estimator,
-      [&sunk, &self](const EpochItem& /*item*/) -> Status {
-        std::this_thread::sleep_for(std::chrono::microseconds(300));  // the queues fill up behind
-        if (sunk.fetch_add(1) == 50) self->stop();
-        return Ok{};
-      },
-      PipelineOptions{true, 16});
-  self = &pipeline;
-  const auto start = std::chrono::steady_clock::now();
-  ASSERT_TRUE(pipeline.run().ok());
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
-  EXPECT_GT(sunk.load(), 51) << "the epochs in the queues were not finished";
-  EXPECT_EQ(sunk.load(), source.produced_.load()) << "an ingested epoch was lost at shutdown";
-  EXPECT_TRUE(estimator.finished);
+  for (const PipelineOptions options : {PipelineOptions{true, 16}, PipelineOptions{false, 16, true}}) {
+    SCOPED_TRACE(options.threaded ? "threaded" : "read-ahead");
+    CountingSource source(-1, std::chrono::microseconds(50));  // endless
+    RecordingEstimator estimator;
+    std::atomic<int> sunk{0};
+    EpochPipeline* self = nullptr;
+    EpochPipeline pipeline(
+        source, estimator,
+        [&sunk, &self](const EpochItem& /*item*/) -> Status {
+          std::this_thread::sleep_for(std::chrono::microseconds(300));  // the queues fill up behind
+          if (sunk.fetch_add(1) == 50) self->stop();
+          return Ok{};
+        },
+        options);
+    self = &pipeline;
+    const auto start = std::chrono::steady_clock::now();
+    ASSERT_TRUE(pipeline.run().ok());
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+    EXPECT_GT(sunk.load(), 51) << "the epochs in the queues were not finished";
+    EXPECT_EQ(sunk.load(), source.produced_.load()) << "an ingested epoch was lost at shutdown";
+    EXPECT_TRUE(estimator.finished);
+  }
 }
 
 TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {
-  for (const bool threaded : {false, true}) {
+  for (const auto& [name, options] : layouts()) {
     CountingSource source(1000, std::chrono::microseconds(0));
     source.fail_at_ = 30;
     RecordingEstimator estimator;
     EpochPipeline pipeline(
-        source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, PipelineOptions{threaded, 4});
+        source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, options);
     const Status s = pipeline.run();
-    ASSERT_FALSE(s.ok());
-    EXPECT_EQ(s.error().message, "source broke");
+    ASSERT_FALSE(s.ok()) << name;
+    EXPECT_EQ(s.error().message, "source broke") << name;
   }
-  for (const bool threaded : {false, true}) {
+  for (const auto& [name, options] : layouts()) {
     CountingSource source(1000, std::chrono::microseconds(0));
     RecordingEstimator estimator;
     int sunk = 0;
@@ -243,11 +269,12 @@ TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {
           if (++sunk == 10) return Error{"disk full", "out.pos", 0};
           return Ok{};
         },
-        PipelineOptions{threaded, 4});
+        options);
     const Status s = pipeline.run();
-    ASSERT_FALSE(s.ok());
-    EXPECT_EQ(s.error().message, "disk full");
-    EXPECT_LT(source.produced_.load(), 1000);
+    ASSERT_FALSE(s.ok()) << name;
+    EXPECT_EQ(s.error().message, "disk full") << name;
+    EXPECT_EQ(sunk, 10) << name << ": the sink was called after its error";
+    EXPECT_LT(source.produced_.load(), 1000) << name;
   }
   CountingSource source(1, std::chrono::microseconds(0));
   RecordingEstimator estimator;

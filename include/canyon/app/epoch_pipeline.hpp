@@ -86,11 +86,12 @@ struct EpochItem {
   std::int64_t base_send_ns = 0;  ///< the base's send time of its epoch's last frame (DDS base; 0 otherwise)
   std::array<std::int64_t, kNumStages> enter_ns{};  ///< per stage (pipeline clock)
   std::array<std::int64_t, kNumStages> exit_ns{};
-  std::optional<fusion::VioPoseAt> pose;  ///< time bridge (fusion)
-  bool to_update = false;                 ///< prediction's verdict: the epoch goes on to the update
-  bool to_resolve = false;                ///< update's verdict: the epoch goes on to ambiguity resolution
-  std::optional<Error> error;             ///< no solution at all (the reason)
-  std::optional<EpochOutput> output;      ///< the solution (after the ambiguity stage)
+  std::optional<fusion::VioPoseAt> pose;       ///< time bridge (fusion)
+  std::optional<rtk::EpochGeometry> geometry;  ///< time bridge (rtk): the epoch's filter-independent geometry
+  bool to_update = false;                      ///< prediction's verdict: the epoch goes on to the update
+  bool to_resolve = false;                     ///< update's verdict: the epoch goes on to ambiguity resolution
+  std::optional<Error> error;                  ///< no solution at all (the reason)
+  std::optional<EpochOutput> output;           ///< the solution (after the ambiguity stage)
 };
 
 /// Where epochs come from (the ingest stage): a rover epoch with its base epoch.
@@ -116,11 +117,13 @@ class EpochEstimator {
   virtual void finish() = 0;
 };
 
-/// RTK (rtk::RtkEngine): no VIO, so no time bridge and no alignment.
+/// RTK (rtk::RtkEngine): no VIO and no alignment; the time bridge builds each epoch's geometry (single-point
+/// solution, observables, satellite states: rtk/epoch_geometry.hpp) ahead of the filter.
 class RtkEstimator final : public EpochEstimator {
  public:
-  explicit RtkEstimator(rtk::RtkEngine& engine) : engine_(engine) {}
-  void bridge(EpochItem& /*item*/) const override {}
+  explicit RtkEstimator(rtk::RtkEngine& engine)
+      : engine_(engine), geometry_(engine.geometry_options(), engine.ephemerides(), engine.base_position_E_m()) {}
+  void bridge(EpochItem& item) const override;
   void align(EpochItem& /*item*/) override {}
   void predict(EpochItem& item) override;
   void update(EpochItem& item) override;
@@ -129,6 +132,8 @@ class RtkEstimator final : public EpochEstimator {
 
  private:
   rtk::RtkEngine& engine_;
+  // The bridge's own builder: bridge() runs on one thread, epoch after epoch (const for the interface's sake).
+  mutable rtk::EpochGeometryBuilder geometry_;
 };
 
 /// The paper's fusion (fusion::FusionEngine).
@@ -153,7 +158,10 @@ using StageObserver = std::function<void(Stage, const EpochItem&)>;
 
 struct PipelineOptions {
   bool threaded = false;            ///< six threads and queues; false: one thread, stage after stage
-  std::size_t queue_capacity = 64;  ///< epochs per queue (threaded)
+  std::size_t queue_capacity = 64;  ///< epochs per queue (threaded, read_ahead)
+  /// With threaded false: ingest and the time bridge run on a second thread, ahead of the other stages (a queue of
+  /// queue_capacity epochs between them; its full waits count as the first queue's). Batch processing on two cores.
+  bool read_ahead = false;
   [[nodiscard]] std::string validate() const;
 };
 
@@ -185,7 +193,10 @@ class EpochPipeline {
  private:
   struct Queues;
   Status run_sequential();
+  Status run_read_ahead();
   Status run_threaded();
+  /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
+  void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
   void run_stage(Stage stage, EpochItem& item);
   void fail(const Error& error);
 

@@ -78,6 +78,7 @@
 #include "canyon/gnss/satellite_states.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/rtk/cycle_slip.hpp"
+#include "canyon/rtk/epoch_geometry.hpp"
 #include "canyon/rtk/observables.hpp"
 
 namespace canyon::rtk {
@@ -189,8 +190,16 @@ class RtkEngine {
   // the same epoch, and `aiding` must stay alive until resolve() or take_epoch().
   /// Prediction: single-point solution, time update (aided, or the engine's own motion model), observables, cycle
   /// slips, single differences, ambiguity bookkeeping. Error as process(); true if the epoch goes on to update(),
-  /// false if its result is final (no base, base too old).
-  Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding = nullptr);
+  /// false if its result is final (no base, base too old). `geometry`: the epoch's geometry built ahead by a builder
+  /// of geometry_options() that saw every epoch before this one (nullptr: the engine builds it; do not mix the two
+  /// on one engine). The engine may change it (it adds satellite states).
+  Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding = nullptr,
+                       EpochGeometry* geometry = nullptr);
+  /// The options of the engine's own geometry builder, for a builder that runs ahead (predict()).
+  [[nodiscard]] EpochGeometryBuilder::Options geometry_options() const;
+  [[nodiscard]] const gnss::EphemerisStore& ephemerides() const { return eph_; }
+  /// The base position the engine was made with (ECEF, m).
+  [[nodiscard]] const Eigen::Vector3d& base_position_E_m() const { return p_E_base_m_; }
   /// Measurement update (DD code and phase EKF with innovation gates and post-fit rejection) and the float solution;
   /// true if the epoch goes on to resolve() (AR on, float consistent), false if its result is final.
   bool update();
@@ -221,10 +230,9 @@ class RtkEngine {
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
   /// Time update with external aiding: p += delta, P_pp += Q, ambiguity random walks.
   void aided_time_update(const core::GpsTime& t, const RtkAiding& aiding);
-  /// `rover_states`: the rover epoch's satellite states (shared with its single-point solution).
-  [[nodiscard]] std::vector<SingleDiff> single_differences(const ReceiverObservables& rover,
-                                                           const ReceiverObservables& base,
-                                                           gnss::EpochSatelliteStates& rover_states) const;
+  /// The single differences of the epoch at the state's position (the rover's satellite states are added to the
+  /// geometry's, shared with its single-point solution).
+  [[nodiscard]] std::vector<SingleDiff> single_differences(EpochGeometry& geometry) const;
   /// Runs both receivers' slip detectors and re-initialises the ambiguities that slipped; the base detector sees
   /// each base epoch once (a base slower than the rover repeats its epochs).
   void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
@@ -324,7 +332,7 @@ class RtkEngine {
   std::map<AmbiguityKey, AmbiguityInfo> ambiguity_info_;
   std::optional<core::GpsTime> last_time_;
   bool initialised_ = false;
-  std::optional<Eigen::Vector3d> last_spp_p_E_m_;
+  EpochGeometryBuilder geometry_builder_;  // predict() without a geometry built ahead
   CycleSlipDetector rover_slips_;
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;

@@ -1,0 +1,88 @@
+#pragma once
+// The part of an RTK epoch that does not depend on the filter: both receivers' observables, the rover's satellite
+// states and single-point solution, and the base's zero-difference models (the base does not move). RtkEngine's
+// prediction builds it itself, or takes it built ahead, e.g. on the staged pipeline's time-bridge thread
+// (app/epoch_pipeline.hpp), where it runs beside the filter's work on the epoch before.
+//
+// Each single-point solution starts from the one before it, a chain that the filter never touches: a builder fed
+// the same epochs in the same order gives the same geometry wherever it runs.
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/geodesy.hpp"
+#include "canyon/core/observation.hpp"
+#include "canyon/core/result.hpp"
+#include "canyon/core/satellite.hpp"
+#include "canyon/gnss/ephemeris.hpp"
+#include "canyon/gnss/satellite_states.hpp"
+#include "canyon/gnss/spp.hpp"
+#include "canyon/rtk/observables.hpp"
+
+namespace canyon::rtk {
+
+/// Zero-difference model of one satellite seen from one receiver.
+struct ZeroDiff {
+  bool valid = false;
+  double model_m = 0.0;                             ///< rho (Sagnac) - c dts + troposphere
+  Eigen::Vector3d los_E = Eigen::Vector3d::Zero();  ///< unit vector receiver -> satellite
+  double elevation_rad = 0.0;
+};
+
+/// A receiver's position with its geodetic coordinates and ENU rotation, for the zero differences of an epoch.
+struct ReceiverGeometry {
+  Eigen::Vector3d p_E_m;
+  core::Geodetic g;
+  Eigen::Matrix3d R_NE;
+
+  explicit ReceiverGeometry(const Eigen::Vector3d& p_E)
+      : p_E_m(p_E), g(core::ecef_to_geodetic(p_E)), R_NE(core::rotation_enu_from_ecef(g)) {}
+};
+
+/// The zero difference of `sat` seen from `receiver`, its state at the transmission time given by `pseudorange_m`
+/// (from `states`); invalid without a usable ephemeris.
+[[nodiscard]] ZeroDiff zero_difference(gnss::EpochSatelliteStates& states, core::SatelliteId sat, double pseudorange_m,
+                                       const ReceiverGeometry& receiver, bool troposphere);
+
+/// Pseudorange of a satellite for the transmission-time computation: the first frequency that has one (NaN if none).
+[[nodiscard]] double any_pseudorange(const ReceiverObservables& obs, core::SatelliteId sat);
+
+/// One epoch's filter-independent inputs (see the top of this file).
+struct EpochGeometry {
+  gnss::EpochSatelliteStates rover_states;  ///< shared by the single-point solution and the rover zero differences
+  Result<gnss::SppSolution> spp;
+  ReceiverObservables rover_obs;
+  bool has_base = false;
+  ReceiverObservables base_obs;  ///< empty without a base epoch
+  /// Zero differences of the base's satellites that have a pseudorange, in base_obs order (ascending satellite).
+  std::vector<std::pair<core::SatelliteId, ZeroDiff>> base_models;
+
+  /// The base model of `sat`; an invalid one if the base has none.
+  [[nodiscard]] ZeroDiff base_model(core::SatelliteId sat) const;
+};
+
+/// Builds the geometry of epochs given in time order (one builder per stream of epochs; not thread-safe, but it may
+/// live on another thread than the engine).
+class EpochGeometryBuilder {
+ public:
+  struct Options {
+    gnss::SppOptions spp;
+    ObservableOptions observables;
+    bool troposphere_saastamoinen = true;  ///< in the zero differences
+  };
+  EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m);
+
+  /// The geometry of `rover` (and `base`, nullptr if none); continues the single-point chain when it solves.
+  [[nodiscard]] EpochGeometry build(const core::ObsEpoch& rover, const core::ObsEpoch* base);
+
+ private:
+  Options options_;
+  const gnss::EphemerisStore* eph_;
+  ReceiverGeometry base_;
+  std::optional<Eigen::Vector3d> last_spp_p_E_m_;
+};
+
+}  // namespace canyon::rtk

@@ -1,0 +1,64 @@
+// The filter-independent part of an RTK epoch (epoch_geometry.hpp).
+
+#include "canyon/rtk/epoch_geometry.hpp"
+
+#include <algorithm>
+
+#include "canyon/core/constants.hpp"
+#include "canyon/gnss/atmosphere.hpp"
+
+namespace canyon::rtk {
+
+ZeroDiff zero_difference(gnss::EpochSatelliteStates& states, const core::SatelliteId sat, double pseudorange_m,
+                         const ReceiverGeometry& receiver, bool troposphere) {
+  ZeroDiff z;
+  const auto state = states.at_reception(sat, pseudorange_m, false);
+  if (!state) return z;
+  const double range_m = gnss::geometric_range_m(state->p_E_m, receiver.p_E_m, &z.los_E);
+  z.elevation_rad = core::elevation_rad(receiver.p_E_m, receiver.g, receiver.R_NE, state->p_E_m);
+  z.model_m = range_m - core::kSpeedOfLightMps * state->clock_bias_s +
+              (troposphere ? gnss::saastamoinen_delay_m(receiver.g, z.elevation_rad) : 0.0);
+  z.valid = true;
+  return z;
+}
+
+double any_pseudorange(const ReceiverObservables& obs, const core::SatelliteId sat) {
+  for (int f = 0; f < kMaxFrequencies; ++f) {
+    if (const SignalObservable* s = obs.find(sat, f); s != nullptr && core::has_value(s->pseudorange_m)) {
+      return s->pseudorange_m;
+    }
+  }
+  return core::kNoValue;
+}
+
+ZeroDiff EpochGeometry::base_model(const core::SatelliteId sat) const {
+  const auto it = std::lower_bound(base_models.begin(), base_models.end(), sat,
+                                   [](const auto& entry, const core::SatelliteId& s) { return entry.first < s; });
+  return it != base_models.end() && it->first == sat ? it->second : ZeroDiff{};
+}
+
+EpochGeometryBuilder::EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides,
+                                           const Eigen::Vector3d& p_E_base_m)
+    : options_(std::move(options)), eph_(&ephemerides), base_(p_E_base_m) {}
+
+EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+  gnss::EpochSatelliteStates rover_states(*eph_, rover.time);
+  auto spp = gnss::solve_spp(rover, *eph_, options_.spp, last_spp_p_E_m_, &rover_states);
+  if (spp) last_spp_p_E_m_ = spp->p_E_m;
+  EpochGeometry out{std::move(rover_states), std::move(spp), select_observables(rover, *eph_, options_.observables),
+                    base != nullptr, {}, {}};
+  if (base == nullptr) return out;
+  out.base_obs = select_observables(*base, *eph_, options_.observables);
+  gnss::EpochSatelliteStates base_states(*eph_, out.base_obs.time);
+  for (std::size_t i = 0; i < out.base_obs.signals.size(); ++i) {
+    const core::SatelliteId sat = out.base_obs.signals[i].sat;
+    if (i > 0 && out.base_obs.signals[i - 1].sat == sat) continue;  // signals are grouped by satellite
+    const double pseudorange_m = any_pseudorange(out.base_obs, sat);
+    if (!core::has_value(pseudorange_m)) continue;
+    out.base_models.emplace_back(
+        sat, zero_difference(base_states, sat, pseudorange_m, base_, options_.troposphere_saastamoinen));
+  }
+  return out;
+}
+
+}  // namespace canyon::rtk
