@@ -7,6 +7,7 @@
 
 #include <readerwriterqueue/readerwritercircularbuffer.h>
 
+#include "canyon/core/batch_queue.hpp"
 #include "canyon/core/time.hpp"
 
 namespace canyon::app {
@@ -224,7 +225,8 @@ Status EpochPipeline::run_sequential() {
 }
 
 Status EpochPipeline::run_read_ahead() {
-  ItemQueue ahead(options_.queue_capacity);
+  // Batches between the two threads (core::BatchQueue): one wake-up per batch and no spinning, for two cores.
+  core::BatchQueue<ItemPtr> ahead(options_.queue_capacity);
   std::thread reader([this, &ahead] {
     for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
       const std::int64_t enter = monotonic_ns();
@@ -237,28 +239,23 @@ Status EpochPipeline::run_read_ahead() {
       auto item = std::make_unique<EpochItem>(std::move(**next));
       ingested(*item, seq, enter);
       run_stage(Stage::TimeBridge, *item);
-      if (!ahead.try_enqueue(std::move(item))) {
-        ++full_waits_[0];
-        ahead.wait_enqueue(std::move(item));  // never drops: back-pressure
-      }
+      ahead.push(std::move(item));  // never drops: back-pressure (the consumer never stops the queue)
     }
-    ahead.wait_enqueue(nullptr);
+    ahead.close();
   });
   // The estimator's stages and the sink on this thread; after an error (fail() stops the reader) the epochs already
   // read are drained without the sink.
-  for (;;) {
-    ItemPtr item;
-    ahead.wait_dequeue(item);
-    if (!item) break;
+  while (std::optional<ItemPtr> item = ahead.pop()) {
     for (std::size_t s = static_cast<std::size_t>(Stage::Alignment); s < kNumStages; ++s) {
-      run_stage(static_cast<Stage>(s), *item);
+      run_stage(static_cast<Stage>(s), **item);
     }
     ++epochs_;
     if (!failed_.load()) {
-      if (Status w = sink_(*item); !w) fail(w.error());
+      if (Status w = sink_(**item); !w) fail(w.error());
     }
   }
   reader.join();
+  full_waits_[0] += ahead.full_waits();
   estimator_.finish();
   return Ok{};
 }

@@ -45,8 +45,12 @@ EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const cor
   gnss::EpochSatelliteStates rover_states(*eph_, rover.time);
   auto spp = gnss::solve_spp(rover, *eph_, options_.spp, last_spp_p_E_m_, &rover_states);
   if (spp) last_spp_p_E_m_ = spp->p_E_m;
-  EpochGeometry out{std::move(rover_states), std::move(spp), select_observables(rover, *eph_, options_.observables),
-                    base != nullptr, {}, {}};
+  EpochGeometry out{std::move(rover_states),
+                    std::move(spp),
+                    select_observables(rover, *eph_, options_.observables),
+                    base != nullptr,
+                    {},
+                    {}};
   if (base == nullptr) return out;
   out.base_obs = select_observables(*base, *eph_, options_.observables);
   gnss::EpochSatelliteStates base_states(*eph_, out.base_obs.time);

@@ -160,7 +160,8 @@ struct PipelineOptions {
   bool threaded = false;            ///< six threads and queues; false: one thread, stage after stage
   std::size_t queue_capacity = 64;  ///< epochs per queue (threaded, read_ahead)
   /// With threaded false: ingest and the time bridge run on a second thread, ahead of the other stages (a queue of
-  /// queue_capacity epochs between them; its full waits count as the first queue's). Batch processing on two cores.
+  /// queue_capacity epochs between them, handed over in batches: core::BatchQueue; its full waits count as the
+  /// first queue's). For batch processing on two cores, not for latency.
   bool read_ahead = false;
   [[nodiscard]] std::string validate() const;
 };
