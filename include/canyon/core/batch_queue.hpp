@@ -91,12 +91,12 @@ class BatchQueue {
   mutable std::mutex mutex_;
   std::condition_variable not_empty_;
   std::condition_variable not_full_;
-  std::deque<T> queue_;  // guarded by mutex_
-  bool closed_ = false;  // guarded by mutex_
-  bool stopped_ = false;  // guarded by mutex_
+  std::deque<T> queue_;         // guarded by mutex_
+  bool closed_ = false;         // guarded by mutex_
+  bool stopped_ = false;        // guarded by mutex_
   std::size_t full_waits_ = 0;  // guarded by mutex_
-  std::deque<T> pending_;  // the producer's side
-  std::deque<T> taken_;    // the consumer's side
+  std::deque<T> pending_;       // the producer's side
+  std::deque<T> taken_;         // the consumer's side
 };
 
 }  // namespace canyon::core
