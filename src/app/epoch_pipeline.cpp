@@ -7,7 +7,6 @@
 
 #include <readerwriterqueue/readerwritercircularbuffer.h>
 
-#include "canyon/core/batch_queue.hpp"
 #include "canyon/core/time.hpp"
 
 namespace canyon::app {
@@ -208,7 +207,6 @@ void EpochPipeline::ingested(EpochItem& item, std::uint64_t seq, std::int64_t en
 }
 
 Status EpochPipeline::run_sequential() {
-  if (options_.read_ahead) return run_read_ahead();
   for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
     const std::int64_t enter = monotonic_ns();
     auto next = source_.next();
@@ -220,42 +218,6 @@ Status EpochPipeline::run_sequential() {
     ++epochs_;
     if (Status w = sink_(item); !w) return w;
   }
-  estimator_.finish();
-  return Ok{};
-}
-
-Status EpochPipeline::run_read_ahead() {
-  // Batches between the two threads (core::BatchQueue): one wake-up per batch and no spinning, for two cores.
-  core::BatchQueue<ItemPtr> ahead(options_.queue_capacity);
-  std::thread reader([this, &ahead] {
-    for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
-      const std::int64_t enter = monotonic_ns();
-      auto next = source_.next();
-      if (!next) {
-        fail(next.error());
-        break;
-      }
-      if (!*next) break;
-      auto item = std::make_unique<EpochItem>(std::move(**next));
-      ingested(*item, seq, enter);
-      run_stage(Stage::TimeBridge, *item);
-      ahead.push(std::move(item));  // never drops: back-pressure (the consumer never stops the queue)
-    }
-    ahead.close();
-  });
-  // The estimator's stages and the sink on this thread; after an error (fail() stops the reader) the epochs already
-  // read are drained without the sink.
-  while (std::optional<ItemPtr> item = ahead.pop()) {
-    for (std::size_t s = static_cast<std::size_t>(Stage::Alignment); s < kNumStages; ++s) {
-      run_stage(static_cast<Stage>(s), **item);
-    }
-    ++epochs_;
-    if (!failed_.load()) {
-      if (Status w = sink_(**item); !w) fail(w.error());
-    }
-  }
-  reader.join();
-  full_waits_[0] += ahead.full_waits();
   estimator_.finish();
   return Ok{};
 }

@@ -73,7 +73,7 @@ struct ProcessArgs {
   bool print_config = false;
   bool quiet = false;
   bool verbose = false;
-  std::string pipeline = "read-ahead";
+  std::string pipeline;
 };
 
 void add_process_command(CLI::App& app, ProcessArgs& args) {
@@ -102,10 +102,9 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
       ->check(CLI::Range(0.0, 89.9));
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
   cmd->add_option("--pipeline", args.pipeline,
-                  "rtk and fusion: run the six stages read-ahead (ingest and time bridge on a thread of their own, "
-                  "ahead of the estimator: the default), sequential (one thread) or threaded (six threads and queues, "
-                  "as canyon rover); all give the same solutions")
-      ->check(CLI::IsMember({"read-ahead", "sequential", "threaded"}));
+                  "rtk and fusion: run the six stages sequential (one thread, the default) or threaded (six "
+                  "threads and queues, as canyon rover); both give the same solutions")
+      ->check(CLI::IsMember({"sequential", "threaded"}));
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
   cmd->add_flag("-v,--verbose", args.verbose, "Log why epochs got no solution or, in rtk mode, no fix (first 100)");
 }
@@ -192,7 +191,6 @@ int run_process_command(const ProcessArgs& args) {
   ProgressBar bar(!args.quiet);
   canyon::app::PipelineOptions pipeline;
   pipeline.threaded = args.pipeline == "threaded";
-  pipeline.read_ahead = args.pipeline == "read-ahead";
   auto summary = canyon::app::run_process(
       config, [&bar](int epochs, double fraction) { bar.update(epochs, fraction); }, pipeline);
   bar.finish();

@@ -48,18 +48,17 @@ std::vector<std::string> without_cpu_times(std::vector<std::string> lines) {
   return lines;
 }
 
-/// The three layouts: one thread, read-ahead (two threads), six threads.
+/// The layouts: one thread, six threads.
 const std::vector<std::pair<std::string, PipelineOptions>>& layouts() {
   static const std::vector<std::pair<std::string, PipelineOptions>> all{
       {"sequential", PipelineOptions{false, 64}},
-      {"read-ahead", PipelineOptions{false, 4, true}},
       {"threaded", PipelineOptions{true, 4}},
   };
   return all;
 }
 
-/// Runs `config` in every layout; returns the sequential .pos file's contents and the other two (read-ahead,
-/// threaded) after checking that their counts and reports equal the sequential run's.
+/// Runs `config` in every layout; returns the sequential .pos file's contents and the others' (threaded) after
+/// checking that their counts and reports equal the sequential run's.
 std::pair<std::string, std::vector<std::string>> every_way(ProcessConfig config, const fs::path& dir) {
   std::optional<ProcessSummary> sequential;
   std::vector<std::string> others;
@@ -91,9 +90,8 @@ TEST(EpochPipeline, EveryLayoutEqualsSequentialRtkInstinct) {
   config->nav = {(data / "RINEX_GN_Spirent.23N").string()};
   const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  ASSERT_EQ(others.size(), 2U);
-  EXPECT_TRUE(seq == others[0]) << "read-ahead .pos differs from sequential";
-  EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
+  ASSERT_EQ(others.size(), 1U);
+  EXPECT_TRUE(seq == others[0]) << "threaded .pos differs from sequential";
 }
 
 TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
@@ -112,9 +110,8 @@ TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
   config->timesync = (dir / "timesync.csv").string();
   const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  ASSERT_EQ(others.size(), 2U);
-  EXPECT_TRUE(seq == others[0]) << "read-ahead .pos differs from sequential";
-  EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
+  ASSERT_EQ(others.size(), 1U);
+  EXPECT_TRUE(seq == others[0]) << "threaded .pos differs from sequential";
 }
 
 // ---- Queues and shutdown, with a fake source and estimator ----
@@ -178,26 +175,24 @@ class RecordingEstimator final : public EpochEstimator {
 };
 
 TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
-  for (const PipelineOptions options : {PipelineOptions{true, 1}, PipelineOptions{false, 1, true}}) {
-    SCOPED_TRACE(options.threaded ? "threaded" : "read-ahead");
-    CountingSource source(200, std::chrono::microseconds(0));
-    RecordingEstimator estimator;
-    std::vector<double> seen;
-    const auto slow_sink = [&seen](const EpochItem& item) -> Status {
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-      seen.push_back(item.output->solution.time.tow_s);
-      return Ok{};
-    };
-    EpochPipeline pipeline(source, estimator, slow_sink, options);
-    ASSERT_TRUE(pipeline.run().ok());
-    ASSERT_EQ(seen.size(), 200U);
-    for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<double>(i));
-    const PipelineStats stats = pipeline.stats();
-    EXPECT_EQ(stats.epochs, 200U);
-    EXPECT_GT(stats.full_waits[0], 0U) << "ingest never found its queue full";
-    EXPECT_TRUE(estimator.finished);
-    for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
-  }
+  const PipelineOptions options{true, 1};
+  CountingSource source(200, std::chrono::microseconds(0));
+  RecordingEstimator estimator;
+  std::vector<double> seen;
+  const auto slow_sink = [&seen](const EpochItem& item) -> Status {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    seen.push_back(item.output->solution.time.tow_s);
+    return Ok{};
+  };
+  EpochPipeline pipeline(source, estimator, slow_sink, options);
+  ASSERT_TRUE(pipeline.run().ok());
+  ASSERT_EQ(seen.size(), 200U);
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<double>(i));
+  const PipelineStats stats = pipeline.stats();
+  EXPECT_EQ(stats.epochs, 200U);
+  EXPECT_GT(stats.full_waits[0], 0U) << "ingest never found its queue full";
+  EXPECT_TRUE(estimator.finished);
+  for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
 }
 
 TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
@@ -224,28 +219,26 @@ TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
 }
 
 TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {
-  for (const PipelineOptions options : {PipelineOptions{true, 16}, PipelineOptions{false, 16, true}}) {
-    SCOPED_TRACE(options.threaded ? "threaded" : "read-ahead");
-    CountingSource source(-1, std::chrono::microseconds(50));  // endless
-    RecordingEstimator estimator;
-    std::atomic<int> sunk{0};
-    EpochPipeline* self = nullptr;
-    EpochPipeline pipeline(
-        source, estimator,
-        [&sunk, &self](const EpochItem& /*item*/) -> Status {
-          std::this_thread::sleep_for(std::chrono::microseconds(300));  // the queues fill up behind
-          if (sunk.fetch_add(1) == 50) self->stop();
-          return Ok{};
-        },
-        options);
-    self = &pipeline;
-    const auto start = std::chrono::steady_clock::now();
-    ASSERT_TRUE(pipeline.run().ok());
-    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
-    EXPECT_GT(sunk.load(), 51) << "the epochs in the queues were not finished";
-    EXPECT_EQ(sunk.load(), source.produced_.load()) << "an ingested epoch was lost at shutdown";
-    EXPECT_TRUE(estimator.finished);
-  }
+  const PipelineOptions options{true, 16};
+  CountingSource source(-1, std::chrono::microseconds(50));  // endless
+  RecordingEstimator estimator;
+  std::atomic<int> sunk{0};
+  EpochPipeline* self = nullptr;
+  EpochPipeline pipeline(
+      source, estimator,
+      [&sunk, &self](const EpochItem& /*item*/) -> Status {
+        std::this_thread::sleep_for(std::chrono::microseconds(300));  // the queues fill up behind
+        if (sunk.fetch_add(1) == 50) self->stop();
+        return Ok{};
+      },
+      options);
+  self = &pipeline;
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(pipeline.run().ok());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  EXPECT_GT(sunk.load(), 51) << "the epochs in the queues were not finished";
+  EXPECT_EQ(sunk.load(), source.produced_.load()) << "an ingested epoch was lost at shutdown";
+  EXPECT_TRUE(estimator.finished);
 }
 
 TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {

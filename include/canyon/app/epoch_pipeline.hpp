@@ -158,11 +158,7 @@ using StageObserver = std::function<void(Stage, const EpochItem&)>;
 
 struct PipelineOptions {
   bool threaded = false;            ///< six threads and queues; false: one thread, stage after stage
-  std::size_t queue_capacity = 64;  ///< epochs per queue (threaded, read_ahead)
-  /// With threaded false: ingest and the time bridge run on a second thread, ahead of the other stages (a queue of
-  /// queue_capacity epochs between them, handed over in batches: core::BatchQueue; its full waits count as the
-  /// first queue's). For batch processing on two cores, not for latency.
-  bool read_ahead = false;
+  std::size_t queue_capacity = 64;  ///< epochs per queue (threaded)
   [[nodiscard]] std::string validate() const;
 };
 
@@ -194,7 +190,6 @@ class EpochPipeline {
  private:
   struct Queues;
   Status run_sequential();
-  Status run_read_ahead();
   Status run_threaded();
   /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
   void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
