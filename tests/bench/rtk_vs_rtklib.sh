@@ -161,12 +161,25 @@ YAML
 
 # Milliseconds one run takes: bash's `time` over the command, median of $runs.
 median() { sort -n | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
+run_ms() {
+  local TIMEFORMAT=%R seconds
+  seconds=$({ time "$@" >/dev/null 2>&1; } 2>&1)
+  awk -v s="$seconds" 'BEGIN {printf "%.1f\n", s * 1000}'
+}
 time_ms() {
-  local TIMEFORMAT=%R seconds i
+  local i
+  for ((i = 0; i < runs; i++)); do run_ms "$@"; done | median
+}
+# Two commands timed in turn (A, B, A, B, ...: both see the same machine): "median_A median_B".
+time_pair_ms() {
+  local a=() i times_a="" times_b=""
+  while [[ $1 != -- ]]; do a+=("$1"); shift; done
+  shift
   for ((i = 0; i < runs; i++)); do
-    seconds=$({ time "$@" >/dev/null 2>&1; } 2>&1)
-    awk -v s="$seconds" 'BEGIN {printf "%.1f\n", s * 1000}'
-  done | median
+    times_a+="$(run_ms "${a[@]}")"$'\n'
+    times_b+="$(run_ms "$@")"$'\n'
+  done
+  echo "$(printf '%s' "$times_a" | median) $(printf '%s' "$times_b" | median)"
 }
 
 # Value of key $2 in a bench_eval_pos --kv line $1, "-" if absent.
@@ -198,7 +211,7 @@ for entry in "${runs_table[@]}"; do
 
   rtklib_cmd=(rnx2rtkp -k "$work/rtklib.conf" -o "$work/rtklib.pos" "$dir/$rover" "$dir/$base" "${navs_abs[@]}")
   "${rtklib_cmd[@]}" >/dev/null 2>&1 || { echo "$name $conf_name: rnx2rtkp failed" >&2; continue; }
-  rtklib_ms=$(time_ms "${rtklib_cmd[@]}")
+  rtklib_ms=-
   rtklib_kv=$("$eval_pos" "$work/rtklib.pos" "${truth_args[@]}" --epochs-in "$epochs_in" --kv)
 
   canyon_fix="-" canyon_rmse="-" canyon_wrong="-" max_dfix="-" canyon_ms="-" speedup="-"
@@ -218,7 +231,7 @@ for entry in "${runs_table[@]}"; do
       canyon_fix="fail"
       echo "$name $conf_name: canyon failed (exit $rc), see $work/canyon.log" >&2
     else
-      canyon_ms=$(time_ms "${canyon_cmd[@]}")
+      read -r rtklib_ms canyon_ms < <(time_pair_ms "${rtklib_cmd[@]}" -- "${canyon_cmd[@]}")
       canyon_kv=$("$eval_pos" "$work/canyon.pos" "${truth_args[@]}" --epochs-in "$epochs_in" --ref "$work/rtklib.pos" --kv)
       canyon_fix=$(kv "$canyon_kv" fixed_pct)
       canyon_rmse=$(kv "$canyon_kv" rmse_3d_m)
@@ -227,11 +240,12 @@ for entry in "${runs_table[@]}"; do
       speedup=$(awk -v c="$canyon_ms" -v r="$rtklib_ms" 'BEGIN {if (c > 0) printf "%.1fx", r / c; else print "-"}')
     fi
   fi
+  [[ $rtklib_ms != - ]] || rtklib_ms=$(time_ms "${rtklib_cmd[@]}")
   row "$name" "$armode" "$canyon_fix" "$(kv "$rtklib_kv" fixed_pct)" "$canyon_rmse" \
     "$(kv "$rtklib_kv" rmse_3d_m)" "$canyon_wrong" "$max_dfix" "$canyon_ms" "$rtklib_ms" "$speedup"
 done
 echo "fix% = fixed epochs / rover epochs; RMSE = 3D RMSE of all solutions vs truth (- : no truth); c wrng = canyon's"
 echo "fixed epochs more than 0.10 m from the truth; max dfix = largest canyon-RTKLIB distance on epochs both fixed;"
-echo "times = whole-process wall time, median of $runs runs."
+echo "times = whole-process wall time, median of $runs runs, canyon and RTKLIB in turn."
 [[ -z $canyon_message ]] || echo "$canyon_message"
 exit 0
