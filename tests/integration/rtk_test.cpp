@@ -49,7 +49,9 @@ std::optional<RtkRun> run_rtk(const std::string& name, const std::string& rover,
   c.base_obs = (shared_data() / base).string();
   for (const auto& n : nav) c.nav.push_back((shared_data() / n).string());
   c.base_position_E_m = p_E_base;
-  c.out = (test::temp_dir("rtk") / (name + ".pos")).string();
+  // A folder per test: ctest runs the tests in parallel, and two of them use the same name.
+  const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  c.out = (test::temp_dir("rtk_" + test_name) / (name + ".pos")).string();
   if (adjust) adjust(c);
   auto summary = app::run_process(c);
   EXPECT_TRUE(summary.ok()) << summary.error().to_string();
