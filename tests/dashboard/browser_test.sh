@@ -29,7 +29,7 @@ cleanup() {
 trap cleanup EXIT
 
 mkfifo "${work}/feed"
-python3 "${here}/feed.py" --rate 5 --seconds 120 --bad-lines > "${work}/feed" &
+python3 "${here}/feed.py" --rate 5 --seconds 400 --bad-lines > "${work}/feed" &
 pids+=($!)
 "${build_dir}/canyon-dashboard" --port 0 --input "${work}/feed" > "${work}/dashboard.log" 2>&1 &
 pids+=($!)
@@ -50,10 +50,10 @@ browser=("${chromium}" --headless=new --no-sandbox --disable-gpu --disable-dev-s
 
 # status KEY: a data attribute of #test-status in the page as Chromium rendered it.
 attr() { sed -n "s|.*<span id=\"test-status\"[^>]* data-$1=\"\([^\"]*\)\".*|\1|p" "${work}/dom.html" | head -1; }
-# The DOM after a few seconds of the page; on a busy machine Chromium may need longer to start: up to 3 tries.
+# The DOM after a few seconds of the page; on a busy machine Chromium may need longer to start: up to 4 tries.
 load() {
   local budget_ms
-  for budget_ms in 5000 10000 20000; do
+  for budget_ms in 5000 10000 20000 40000; do
     timeout 90 "${browser[@]}" --timeout="${budget_ms}" --dump-dom "${url}" 2> /dev/null > "${work}/dom.html" || true
     if [[ "$(attr updates)" =~ ^[1-9] ]]; then return 0; fi
   done
