@@ -45,7 +45,6 @@ std::int64_t monotonic_ns() {
 // ---- Estimators: the engines' stages ----
 
 void RtkEstimator::bridge(EpochItem& item) const {
-  if (!geometry_ahead_) return;
   item.geometry.emplace(geometry_.build(item.rover, item.base ? &*item.base : nullptr));
 }
 

@@ -118,15 +118,11 @@ class EpochEstimator {
 };
 
 /// RTK (rtk::RtkEngine): no VIO and no alignment; the time bridge builds each epoch's geometry (single-point
-/// solution, observables, satellite states: rtk/epoch_geometry.hpp) ahead of the filter, unless `geometry_ahead` is
-/// false: then the prediction builds it (needed when the ephemerides grow while running, as they are added in the
-/// alignment stage after the bridge has run ahead: app/rover_ingest.hpp).
+/// solution, observables, satellite states: rtk/epoch_geometry.hpp) ahead of the filter.
 class RtkEstimator final : public EpochEstimator {
  public:
-  explicit RtkEstimator(rtk::RtkEngine& engine, bool geometry_ahead = true)
-      : engine_(engine),
-        geometry_ahead_(geometry_ahead),
-        geometry_(engine.geometry_options(), engine.ephemerides(), engine.base_position_E_m()) {}
+  explicit RtkEstimator(rtk::RtkEngine& engine)
+      : engine_(engine), geometry_(engine.geometry_options(), engine.ephemerides(), engine.base_position_E_m()) {}
   void bridge(EpochItem& item) const override;
   void align(EpochItem& /*item*/) override {}
   void predict(EpochItem& item) override;
@@ -136,7 +132,6 @@ class RtkEstimator final : public EpochEstimator {
 
  private:
   rtk::RtkEngine& engine_;
-  bool geometry_ahead_;
   // The bridge's own builder: bridge() runs on one thread, epoch after epoch (const for the interface's sake).
   mutable rtk::EpochGeometryBuilder geometry_;
 };
