@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "canyon/core/ephemeris.hpp"
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
@@ -84,6 +85,9 @@ struct EpochItem {
   std::int64_t arrival_ns = 0;    ///< the epoch complete at ingest, rover and base (pipeline clock; 0: the pipeline
                                   ///< stamps it when the source returns it); the ingest stage is timed from it
   std::int64_t base_send_ns = 0;  ///< the base's send time of its epoch's last frame (DDS base; 0 otherwise)
+  /// Ephemerides that arrived on the rover's or the base's stream before this epoch (nullptr: none); the
+  /// estimator adds them to its store before the epoch's alignment stage (app/rover_ingest.hpp, EphemerisFeed).
+  std::shared_ptr<const core::NavigationData> navigation;
   std::array<std::int64_t, kNumStages> enter_ns{};  ///< per stage (pipeline clock)
   std::array<std::int64_t, kNumStages> exit_ns{};
   std::optional<fusion::VioPoseAt> pose;       ///< time bridge (fusion)
