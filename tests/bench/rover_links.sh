@@ -5,8 +5,8 @@
 #                Both .pos equal canyon process on the recorded stream, byte for byte (header lines aside).
 #  base-str2str  RTKLIB str2str serves canyon convert's RTCM 3 of the base file as tcpsvr:// and as NTRIP caster
 #                (ntripc://); both rovers equal canyon process on that RTCM 3 file, byte for byte.
-#  ubx           the u-blox M8P rover log of m8p-galway-20181004 (input.rover ubx) from the file and over TCP from
-#                str2str tcpsvr://: the two .pos are equal byte for byte; against canyon process on canyon convert's
+#  ubx           the u-blox M8P rover log of m8p-galway-20181004 (input.rover ubx) from the file, over TCP from
+#                str2str tcpsvr:// and over a serial line (a pseudo-terminal): the .pos are equal byte for byte; against canyon process on canyon convert's
 #                RINEX of the same log the positions agree within kMaxUbxRinexDiffM (RINEX rounds pseudoranges to
 #                1 mm, phases to 0.001 cycle and time tags to 0.1 us) with the same statuses. Also reported: the
 #                rover with the SFRBX ephemerides only (no navigation file).
@@ -258,6 +258,41 @@ part_ubx() {
       "(byte for byte); then 'link lost', exit 1"
   else
     fail ubx "rover over TCP (exit ${tcp_rc}) differs from the file run (diff ${dir}/tcp.pos ${dir}/file.pos)"
+  fi
+  # Over a serial line: a pseudo-terminal (a real tty device, no receiver needed) carries the log.
+  rm -f pty_name
+  python3 - rover.ubx pty_name rover_serial.log << 'PY' &
+import os, pty, sys, time
+master, slave = pty.openpty()
+open(sys.argv[2], "w").write(os.ttyname(slave) + "\n")
+os.close(slave)
+for _ in range(300):  # write once the rover has opened the device (raw mode): it logs its start line then
+    if os.path.exists(sys.argv[3]) and "rover '" in open(sys.argv[3]).read():
+        break
+    time.sleep(0.1)
+time.sleep(0.5)
+view = memoryview(open(sys.argv[1], "rb").read())
+while view:  # a tty's writes block while the reader is behind: nothing is lost
+    view = view[os.write(master, view[:4096]) :]
+time.sleep(2)
+os.close(master)  # the device goes away
+PY
+  local feeder=$!
+  for _ in $(seq 100); do
+    [[ -s pty_name ]] && break
+    sleep 0.1
+  done
+  rover_yaml rover_serial "${est}
+  nav: [rover.nav]" "rover: ubx, rover_source: 'serial://$(cat pty_name)?baud=115200', stream_ephemerides: false"
+  timeout 120 "${canyon}" rover --config rover_serial.yaml --out serial.pos > rover_serial.log 2>&1
+  local serial_rc=$?
+  wait "${feeder}"
+  if same_records serial.pos file.pos && ((serial_rc == 1)) && grep -q "device gone" rover_serial.log; then
+    pass ubx "rover from the UBX log over a serial line (pseudo-terminal $(cat pty_name)): $(records serial.pos |
+      wc -l) solutions = the file run (byte for byte); then 'serial link failed: ... device gone', exit 1"
+  else
+    fail ubx "rover over a serial line (exit ${serial_rc}) differs from the file run (diff ${dir}/serial.pos" \
+      "${dir}/file.pos; ${dir}/rover_serial.log)"
   fi
   read -r -a c <<< "$(compare_pos file.pos sfrbx.pos)"
   local first_same
