@@ -18,7 +18,40 @@ io::GnssStreamOptions ubx_options() {
   return o;
 }
 
+RoverIngest::Summary stream_summary(const std::string& name, const ByteLink* link, const io::GnssStreamDecoder& d,
+                                    std::uint64_t epochs) {
+  const io::GnssStreamStats s = d.stats();
+  const std::uint64_t undecodable = s.rtcm3_decode_errors + s.ubx_decode_errors;
+  std::string text = name + ": ";
+  bool problems = s.framing.bad_packets() > 0 || undecodable > 0;
+  if (link != nullptr) {
+    const LinkStats l = link->stats();
+    text += std::to_string(l.bytes) + " bytes, " + std::to_string(l.dropped_bytes) + " dropped (queue full), " +
+            std::to_string(l.failures) + " failed connection attempts; ";
+    problems = problems || l.dropped_bytes > 0 || l.failures > 0;
+  }
+  text += std::to_string(s.framing.rtcm3_frames) + " RTCM 3 frames, " + std::to_string(s.framing.ubx_packets) +
+          " UBX packets, " + std::to_string(s.framing.bad_packets()) + " bad or cut, " +
+          std::to_string(s.framing.garbage_bytes) + " garbage bytes, " + std::to_string(undecodable) +
+          " undecodable; " + std::to_string(epochs) + " epochs";
+  return {std::move(text), problems};
+}
+
 }  // namespace
+
+std::vector<RoverIngest::Summary> RoverIngest::summary() const {
+  std::vector<Summary> out;
+  if (rover_.receiver) {
+    const io::GnssStreamDecoder& d = rover_.receiver->decoder();
+    out.push_back(stream_summary("rover " + rover_.receiver->link().address().text, &rover_.receiver->link(), d,
+                                 d.stats().ubx_epochs));
+  }
+  if (live_) {
+    out.push_back(
+        stream_summary(base_.name, base_.link.get(), live_->decoder(), live_->decoder().stats().rtcm3_epochs));
+  }
+  return out;
+}
 
 std::shared_ptr<const core::NavigationData> NavigationCursor::take(const core::NavigationData& all) {
   const bool new_klobuchar = !klobuchar_ && (all.gps_klobuchar || all.bds_klobuchar);

@@ -129,8 +129,10 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
       if (!address) return address.error();
       auto link = app::ByteLink::open(*address, config.link, link_log("base"));
       if (!link) return link.error();
-      input.poll = app::link_base_poll(std::shared_ptr<app::ByteLink>(std::move(*link)), log_warning);
+      std::shared_ptr<app::ByteLink> shared(std::move(*link));
+      input.poll = app::link_base_poll(shared, log_warning);
       input.name = "base " + config.base_source;
+      input.link = std::move(shared);
       break;
     }
   }
@@ -416,6 +418,13 @@ int run(int argc, char** argv) {
   if (base_frames_dropped.load() > 0 || base_frames_bad.load() > 0) {
     spdlog::warn("base: {} RTCM frames dropped (queue full), {} malformed", base_frames_dropped.load(),
                  base_frames_bad.load());
+  }
+  for (const app::RoverIngest::Summary& s : source.summary()) {
+    if (s.problems) {
+      spdlog::warn("{}", s.text);
+    } else {
+      spdlog::info("{}", s.text);
+    }
   }
   if (source.base_late() > 0) {
     spdlog::warn("base: {} epochs went on without waiting longer for their base epoch (input.base_wait_s {})",

@@ -94,7 +94,8 @@ struct BaseInput {
   using PollFn = std::function<bool(std::int64_t timeout_us, LiveBaseCursor& cursor)>;
   std::optional<BaseCursor> file;
   PollFn poll;
-  std::string name = "base";  ///< names the stream in warnings ("base tcp://host:2102")
+  std::string name = "base";             ///< names the stream in warnings ("base tcp://host:2102")
+  std::shared_ptr<const ByteLink> link;  ///< the link `poll` reads, if any (for its counts in the summary)
 };
 
 /// A PollFn reading RTCM 3 from a link (NTRIP, TCP). A link that fails for good is logged once (what and where);
@@ -117,6 +118,14 @@ class RoverIngest final : public EpochSource {
   [[nodiscard]] std::uint64_t base_late() const { return base_late_.load(); }
   /// The streamed base's decoder (nullptr before the first epoch or with a file base).
   [[nodiscard]] const LiveBaseCursor* live_base() const { return live_ ? &*live_ : nullptr; }
+  /// What the streams delivered and lost, one line per stream (receiver, streamed base): bytes, bytes dropped,
+  /// failed connection attempts, packets, bad and cut packets, undecodable messages, epochs. `problems` is set if
+  /// anything was lost. Call after the run.
+  struct Summary {
+    std::string text;
+    bool problems = false;
+  };
+  [[nodiscard]] std::vector<Summary> summary() const;
 
  private:
   Result<std::optional<core::ObsEpoch>> next_rover();
