@@ -183,6 +183,10 @@ Result<LinkAddress> LinkAddress::parse(const std::string& text, const std::strin
   if (!*url) return Error{"'" + text + "' is not a link address: " + kForms};
   a.kind = (*url)->ntrip ? Kind::Ntrip : Kind::Tcp;
   a.url = **url;
+  if (!a.url.password.empty()) {  // logs and messages do not show it
+    const std::string secret = ":" + a.url.password + "@";
+    if (const std::size_t at = a.text.find(secret); at != std::string::npos) a.text.replace(at, secret.size(), ":***@");
+  }
   return a;
 }
 

@@ -131,7 +131,7 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
       if (!link) return link.error();
       std::shared_ptr<app::ByteLink> shared(std::move(*link));
       input.poll = app::link_base_poll(shared, log_warning);
-      input.name = "base " + config.base_source;
+      input.name = "base " + address->text;
       input.link = std::move(shared);
       break;
     }
@@ -194,10 +194,15 @@ int run(int argc, char** argv) {
   }
   const app::ProcessConfig& est = config->estimator;
   const bool dds_base = config->base == app::RoverBaseSource::Dds;
-  const std::string rover_from = config->rover == app::RoverInputKind::Ubx ? config->rover_source : est.rover_obs;
+  const auto shown = [](const std::string& link) {  // a link as messages show it (no password)
+    auto address = app::LinkAddress::parse(link);
+    return address ? address->text : link;
+  };
+  const std::string rover_from =
+      config->rover == app::RoverInputKind::Ubx ? shown(config->rover_source) : est.rover_obs;
   const std::string base_from = config->base == app::RoverBaseSource::File ? est.base_obs
                                 : dds_base                                 ? "DDS " + config->rtcm_topic
-                                                                           : config->base_source;
+                                                                           : shown(config->base_source);
 
   // DDS first: profiles before any participant.
   std::string profiles = config->profiles;

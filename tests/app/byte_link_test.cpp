@@ -70,6 +70,7 @@ TEST(LinkAddress, ParsesEveryFormAndNamesTheFormsOnError) {
   EXPECT_EQ(ntrip->url.mount, "CANYON");
   EXPECT_EQ(ntrip->url.user, "me");
   EXPECT_EQ(ntrip->url.password, "secret");
+  EXPECT_EQ(ntrip->text, "ntrip://me:***@caster:2101/CANYON");  // messages never show the password
   EXPECT_NE(LinkAddress::parse("log.ubx").error().message.find("file:PATH"), std::string::npos);
   EXPECT_FALSE(LinkAddress::parse("serial://ttyACM0"));
   EXPECT_FALSE(LinkAddress::parse("serial:///dev/ttyACM0?baud=fast"));

@@ -2,14 +2,16 @@
 # canyon rover on real links, each peer a real program:
 #  base-canyon   canyon base (RINEX replay of instinct-spirent-rtk-sim) serves NTRIP and TCP; two rovers take their base
 #                from it (input.base ntrip, tcp); a canyon record of the base's DDS topic keeps the same RTCM stream.
-#                Both .pos equal canyon process on the recorded stream, byte for byte (header lines aside).
+#                Both .pos equal canyon process on the recorded stream, byte for byte (header lines aside). A third
+#                rover with a wrong NTRIP password gets the 401 reported (password not shown) and goes on.
 #  base-str2str  RTKLIB str2str serves canyon convert's RTCM 3 of the base file as tcpsvr:// and as NTRIP caster
 #                (ntripc://); both rovers equal canyon process on that RTCM 3 file, byte for byte.
 #  ubx           the u-blox M8P rover log of m8p-galway-20181004 (input.rover ubx) from the file, over TCP from
-#                str2str tcpsvr:// and over a serial line (a pseudo-terminal): the .pos are equal byte for byte; against canyon process on canyon convert's
-#                RINEX of the same log the positions agree within kMaxUbxRinexDiffM (RINEX rounds pseudoranges to
-#                1 mm, phases to 0.001 cycle and time tags to 0.1 us) with the same statuses. Also reported: the
-#                rover with the SFRBX ephemerides only (no navigation file).
+#                str2str tcpsvr:// and over a serial line (a pseudo-terminal): the .pos are equal byte for byte;
+#                against canyon process on canyon convert's RINEX of the same log the positions agree within
+#                kMaxUbxRinexDiffM (RINEX rounds pseudoranges to 1 mm, phases to 0.001 cycle and time tags to
+#                0.1 us) with the same statuses. Also reported: the rover with the SFRBX ephemerides only (no
+#                navigation file), threaded = sequential.
 #  bad           a refused rover link, a refused base link, a receiver link that dies mid-log, a truncated log,
 #                corrupt RTCM frames and SIGINT: each ends (or goes on) with a message naming the link, never hangs.
 #
@@ -137,12 +139,13 @@ part_base_canyon() {
     echo "input: {kind: rinex, source: file, path: ${inst_base}, nav: [${inst_nav}], pace: ${base_pace}}"
     echo "outputs:"
     echo "  dds: {enabled: true, domain: ${domain}, topic: canyon/rtcm, profiles: ${profiles}}"
-    echo "  ntrip: {enabled: true, bind: 127.0.0.1, port: ${ntrip_port}, mountpoint: CANYON}"
+    echo "  ntrip: {enabled: true, bind: 127.0.0.1, port: ${ntrip_port}, mountpoint: CANYON,"
+    echo "          user: rover, password: s3cret}"
     echo "  tcp: {enabled: true, bind: 127.0.0.1, port: ${tcp_port}}"
     echo "log: {progress_interval_s: 0}"
   } > base.yaml
   rover_yaml rover_ntrip "$(inst_estimator)" \
-    "pace: 0, base: ntrip, base_source: 'ntrip://127.0.0.1:${ntrip_port}/CANYON', base_wait_s: 5"
+    "pace: 0, base: ntrip, base_source: 'ntrip://rover:s3cret@127.0.0.1:${ntrip_port}/CANYON', base_wait_s: 5"
   rover_yaml rover_tcp "$(inst_estimator)" \
     "pace: 0, base: tcp, base_source: 'tcp://127.0.0.1:${tcp_port}', base_wait_s: 5"
   timeout 120 "${canyon}" record canyon/rtcm --out base.rtcm3 --domain "${domain}" 2> record_rtcm.log &
@@ -151,6 +154,11 @@ part_base_canyon() {
   local r1=$!
   timeout 120 "${canyon}" rover --config rover_tcp.yaml --out tcp.pos > rover_tcp.log 2>&1 &
   local r2=$!
+  # A rover with a wrong password: refused (401), reported; it goes on without a base.
+  rover_yaml rover_badauth "$(inst_estimator)" "pace: 0, base: ntrip, base_wait_s: 0.5, link_attempts: 2,
+    base_source: 'ntrip://rover:wrong@127.0.0.1:${ntrip_port}/CANYON'"
+  timeout 120 "${canyon}" rover --config rover_badauth.yaml --out badauth.pos > rover_badauth.log 2>&1 &
+  local r3=$!
   # Three clients: the NTRIP rover, the TCP rover, the RTCM recorder (DDS).
   timeout 120 "${canyon}" base --config base.yaml --wait-for-clients 3 -q > base.log 2>&1
   local base_rc=$?
@@ -159,7 +167,17 @@ part_base_canyon() {
   wait "${r2}"
   rc[tcp]=$?
   wait "${rec}"
+  wait "${r3}"
+  local badauth_rc=$?
   ((base_rc == 0)) || fail base-canyon "canyon base exit ${base_rc} (${dir}/base.log)"
+  if ((badauth_rc == 0)) && grep -q "link lost: gave up reconnecting (last: .*401" rover_badauth.log &&
+    ! grep -q wrong rover_badauth.log; then
+    pass base-canyon "rover with a wrong NTRIP password: $(grep -m1 'link lost' rover_badauth.log |
+      sed 's/^\[[^]]*\] \[[^]]*\] //')"
+  else
+    fail base-canyon "rover with a wrong NTRIP password: exit ${badauth_rc}, no 401 reported or the password shown" \
+      "(${dir}/rover_badauth.log)"
+  fi
   check_two_rovers base-canyon "${dir}"
 }
 
@@ -225,6 +243,8 @@ part_ubx() {
   local file_rc=$?
   timeout 60 "${canyon}" rover --config rover_sfrbx.yaml --out sfrbx.pos > rover_sfrbx.log 2>&1
   local sfrbx_rc=$?
+  timeout 60 "${canyon}" rover --config rover_sfrbx.yaml --pipeline sequential --out sfrbx_sequential.pos \
+    > rover_sfrbx_sequential.log 2>&1
   # Over TCP: str2str serves the log (decompressed) as tcpsvr:// once the rover is connected.
   zcat "${m8p_rover_ubx}" > rover.ubx
   mkfifo feed
@@ -298,12 +318,13 @@ PY
   local first_same
   first_same=$(paste -d'|' <(records file.pos | tail -n "$(records sfrbx.pos | wc -l)") <(records sfrbx.pos) |
     awk -F'|' '$1 != $2 { last = NR } END { print last + 1 }')
-  if ((sfrbx_rc == 0)); then
+  if ((sfrbx_rc == 0)) && same_records sfrbx.pos sfrbx_sequential.pos; then
     pass ubx "rover with the SFRBX ephemerides only (no nav file): ${c[4]} of ${c[3]} epochs solved," \
       "$(records sfrbx.pos | awk '$6 == 1' | wc -l) fixed (nav file: $(records file.pos | awk '$6 == 1' | wc -l));" \
-      "identical to the nav-file run from its solution ${first_same} on"
+      "identical to the nav-file run from its solution ${first_same} on; threaded = sequential (byte for byte)"
   else
-    fail ubx "rover with the SFRBX ephemerides only: exit ${sfrbx_rc} (${dir}/rover_sfrbx.log)"
+    fail ubx "rover with the SFRBX ephemerides only: exit ${sfrbx_rc} (${dir}/rover_sfrbx.log), or threaded" \
+      "differs from sequential (diff ${dir}/sfrbx.pos ${dir}/sfrbx_sequential.pos)"
   fi
 }
 
@@ -419,7 +440,8 @@ PY
   wait "${s2s}" 2> /dev/null
   local what
   what="$(grep -c 'base tcp.*: byte' corrupt.log) reported, $(records corrupt.pos | wc -l) solutions"
-  expect "corrupt RTCM frames (${what})" 0 "${code}" corrupt.log "base tcp://127.0.0.1:${port}: byte [0-9]*: " 30 "${start}"
+  expect "corrupt RTCM frames (${what})" 0 "${code}" corrupt.log "base tcp://127.0.0.1:${port}: byte [0-9]*: " 30 \
+    "${start}"
 
   # SIGINT during a real-time replay: stops within a second, the epochs in flight written.
   rover_yaml sigint "${est}" "pace: 1, rover: ubx, rover_source: 'file:${m8p_rover_ubx}'"

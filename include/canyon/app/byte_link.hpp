@@ -32,7 +32,7 @@ struct LinkAddress {
   std::string path;  ///< file or serial device
   int baud = 115200;
   StreamUrl url;     ///< tcp, ntrip
-  std::string text;  ///< as written (messages name the link by it)
+  std::string text;  ///< as written, a password replaced by *** (messages name the link by it)
 
   /// One of the forms in the file comment; a relative file path is taken relative to `folder` (if not empty).
   /// Error naming the text and the accepted forms.
