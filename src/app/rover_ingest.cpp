@@ -169,7 +169,10 @@ Status RoverIngest::attach_base(EpochItem& item) {
     return Ok{};
   }
   if (!base_.poll) return Ok{};
-  if (!live_) live_.emplace(t, [this](std::int64_t timeout_us) { return base_.poll(timeout_us, *live_); });
+  if (!live_) {
+    // Stopping ends the wait for the base at once (false: the base counts as ended).
+    live_.emplace(t, [this](std::int64_t timeout_us) { return !stopped_() && base_.poll(timeout_us, *live_); });
+  }
   const std::int64_t wait_ns = static_cast<std::int64_t>(options_.base_wait_s * 1e9);
   const LiveBaseCursor::Match match = live_->at(t, core::pipeline_now_ns() + wait_ns);
   base_problems_.report(base_.name, live_->decoder(), warn_);

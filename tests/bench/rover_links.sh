@@ -452,6 +452,32 @@ PY
   kill -INT "${rov}"
   wait "${rov}"
   expect "SIGINT ($(records sigint.pos | wc -l) solutions)" 0 $? sigint.log "stopped by signal" 3 "${start}"
+
+  # SIGINT while a rover epoch waits (input.base_wait_s 30) for a base that is connected but silent.
+  port=$(free_port)
+  python3 - "${port}" << 'PY' &
+import socket, sys, time
+server = socket.socket()
+server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+server.bind(("127.0.0.1", int(sys.argv[1])))
+server.listen(1)
+server.settimeout(30)
+conn, _ = server.accept()
+time.sleep(15)
+PY
+  peer=$!
+  rover_yaml silent "$(inst_estimator)" \
+    "pace: 0, base: tcp, base_source: 'tcp://127.0.0.1:${port}', base_wait_s: 30, link_stall_timeout_s: 60"
+  timeout 60 "${canyon}" rover --config silent.yaml --out silent.pos > silent.log 2>&1 &
+  rov=$!
+  wait_clients "${port}" 1
+  sleep 1
+  start=$(date +%s.%N)
+  kill -INT "${rov}"
+  wait "${rov}"
+  expect "SIGINT while waiting for a silent base" 0 $? silent.log "stopped by signal" 3 "${start}"
+  kill "${peer}" 2> /dev/null
+  wait "${peer}" 2> /dev/null
 }
 
 mkdir -p "${work}"
