@@ -196,9 +196,8 @@ void RoverIngest::attach_navigation(EpochItem& item) {
   }
 }
 
-void EphemerisFeed::align(EpochItem& item) {
-  if (item.navigation) added_.fetch_add(static_cast<std::uint64_t>(store_.add(*item.navigation)));
-  inner_.align(item);
+void EphemerisFeed::add_navigation(const core::NavigationData& fresh) {
+  added_.fetch_add(static_cast<std::uint64_t>(store_.add(fresh)));
 }
 
 }  // namespace canyon::app

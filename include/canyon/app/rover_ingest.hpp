@@ -4,9 +4,9 @@
 // pace, serial, TCP, NTRIP); base epochs from a RINEX file (BaseCursor) or from RTCM 3 that streams in
 // (LiveBaseCursor: frames from DDS, handed in by the caller, or bytes from a ByteLink, NTRIP or TCP). Ephemerides
 // that arrive on the streams (SFRBX, RTCM 1019/1020/1042/1045/1046) travel with the epoch they arrived before
-// (EpochItem::navigation) and are added to the estimator's store by EphemerisFeed in the alignment stage, the first
-// stage that runs one epoch at a time: the threaded and the sequential pipeline use the same ephemerides for the
-// same epoch.
+// (EpochItem::navigation) and are added to the estimator's store by EphemerisFeed when the pipeline has drained
+// the epochs before (EpochPipeline): the threaded and the sequential pipeline use the same ephemerides for the same
+// epoch.
 //
 // Nothing is dropped silently: a corrupt frame or packet is logged with its byte offset in the stream (and the
 // stream goes on); a rover epoch that waited past base_wait_s for its base is counted (base_late); a link that
@@ -146,17 +146,18 @@ class RoverIngest final : public EpochSource {
   std::atomic<std::uint64_t> base_late_{0};
 };
 
-/// An estimator that first adds the ephemerides an epoch brought (EpochItem::navigation) to the store the engine
-/// reads, in the alignment stage (one epoch at a time, no other stage reading the store), then runs `inner`.
+/// An estimator whose add_navigation() adds the ephemerides to the store the engine reads (the pipeline calls it
+/// while no stage runs); every stage is `inner`'s.
 class EphemerisFeed final : public EpochEstimator {
  public:
   EphemerisFeed(EpochEstimator& inner, gnss::EphemerisStore& store) : inner_(inner), store_(store) {}
   void bridge(EpochItem& item) const override { inner_.bridge(item); }
-  void align(EpochItem& item) override;
+  void align(EpochItem& item) override { inner_.align(item); }
   void predict(EpochItem& item) override { inner_.predict(item); }
   void update(EpochItem& item) override { inner_.update(item); }
   void resolve(EpochItem& item) override { inner_.resolve(item); }
   void finish() override { inner_.finish(); }
+  void add_navigation(const core::NavigationData& fresh) override;
   /// Ephemeris records added so far.
   [[nodiscard]] std::uint64_t added() const { return added_.load(); }
 
