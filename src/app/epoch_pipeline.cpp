@@ -2,6 +2,7 @@
 
 #include "canyon/app/epoch_pipeline.hpp"
 
+#include <chrono>
 #include <thread>
 #include <utility>
 
@@ -177,7 +178,10 @@ void EpochPipeline::run_stage(Stage stage, EpochItem& item) {
   item.enter_ns[i] = monotonic_ns();
   switch (stage) {
     case Stage::Ingest: break;
-    case Stage::TimeBridge: estimator_.bridge(item); break;
+    case Stage::TimeBridge:
+      if (item.navigation) add_navigation(item);
+      estimator_.bridge(item);
+      break;
     case Stage::Alignment: estimator_.align(item); break;
     case Stage::Prediction: estimator_.predict(item); break;
     case Stage::Update:
@@ -204,6 +208,12 @@ void EpochPipeline::ingested(EpochItem& item, std::uint64_t seq, std::int64_t en
   item.enter_ns[0] = item.arrival_ns;
   item.exit_ns[0] = monotonic_ns();
   if (observer_) observer_(Stage::Ingest, item);
+}
+
+void EpochPipeline::add_navigation(const EpochItem& item) {
+  // Every earlier epoch has left the last stage (sequential: always so), then no stage reads the ephemerides.
+  while (epochs_.load() < item.seq) std::this_thread::sleep_for(std::chrono::microseconds(50));
+  estimator_.add_navigation(*item.navigation);
 }
 
 Status EpochPipeline::run_sequential() {

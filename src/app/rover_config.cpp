@@ -2,19 +2,69 @@
 
 #include "canyon/app/rover_config.hpp"
 
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <optional>
+
 #include "canyon/app/yaml_reader.hpp"
 
 namespace canyon::app {
+namespace {
+
+constexpr std::array<std::pair<RoverBaseSource, const char*>, 4> kBaseSources{{
+    {RoverBaseSource::File, "file"},
+    {RoverBaseSource::Dds, "dds"},
+    {RoverBaseSource::Ntrip, "ntrip"},
+    {RoverBaseSource::Tcp, "tcp"},
+}};
+
+/// The link address rule for `key` (empty: fine).
+std::string check_link(const std::string& key, const std::string& text, std::optional<LinkAddress::Kind> kind) {
+  if (text.empty()) return key + " is required";
+  auto address = LinkAddress::parse(text);
+  if (!address) return key + ": " + address.error().message;
+  if (kind && address->kind != *kind)
+    return key + " must be " + (*kind == LinkAddress::Kind::Ntrip ? "ntrip://" : "tcp://") + "...";
+  return {};
+}
+
+/// A file: link address relative to the configuration file's folder.
+std::string resolve_link(const std::string& text, const std::string& file) {
+  if (text.rfind("file:", 0) != 0 || file.empty()) return text;
+  auto address = LinkAddress::parse(text, std::filesystem::path(file).parent_path().string());
+  return address ? "file:" + address->path : text;
+}
+
+}  // namespace
+
+const char* rover_base_source_name(RoverBaseSource source) {
+  for (const auto& [s, name] : kBaseSources) {
+    if (s == source) return name;
+  }
+  return "?";
+}
 
 std::string RoverConfig::validate() const {
   if (estimator.mode == ProcessMode::Spp) return "estimator.mode must be rtk or fusion";
   ProcessConfig e = estimator;
-  if (e.out.empty()) e.out = "-";                                            // the rover's own .pos is optional
-  if (base == RoverBaseSource::Dds && e.base_obs.empty()) e.base_obs = "-";  // the base comes over DDS
+  if (e.out.empty()) e.out = "-";                               // the rover's own .pos is optional
+  if (streamed_base() && e.base_obs.empty()) e.base_obs = "-";  // the base streams in
+  if (rover == RoverInputKind::Ubx && e.rover_obs.empty()) e.rover_obs = "-";
+  const bool streams_nav = stream_ephemerides && (rover == RoverInputKind::Ubx || streamed_base());
+  if (streams_nav && e.nav.empty()) e.nav = {"-"};  // ephemerides from the streams only
   if (const std::string s = e.validate(); !s.empty()) return "estimator: " + s;
   if (estimator.exclude_most_observed != 0) return "estimator.exclude_most_observed needs the whole file: batch only";
   if (rover_id.empty() || rover_id.size() > 64) return "rover_id must have 1 to 64 characters";
   if (!(pace >= 0.0)) return "input.pace must be >= 0";
+  if (rover == RoverInputKind::Ubx) {
+    if (std::string r = check_link("input.rover_source", rover_source, std::nullopt); !r.empty()) return r;
+  }
+  if (base == RoverBaseSource::Ntrip || base == RoverBaseSource::Tcp) {
+    const auto kind = base == RoverBaseSource::Ntrip ? LinkAddress::Kind::Ntrip : LinkAddress::Kind::Tcp;
+    if (std::string r = check_link("input.base_source", base_source, kind); !r.empty()) return r;
+  }
+  if (const std::string l = link.validate(); !l.empty()) return "input.link_" + l;
   if (!(base_wait_s > 0.0 && base_wait_s <= 60.0)) return "input.base_wait_s must be in (0, 60]";
   if (base_queue_frames < 16 || base_queue_frames > 1000000) return "input.base_queue_frames must be in 16..1000000";
   if (const std::string s = pipeline.validate(); !s.empty()) return "pipeline." + s;
@@ -40,15 +90,32 @@ Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string
   top.get("rover_id", c.rover_id);
   YamlMap input = top.sub("input");
   input.get("pace", c.pace);
-  std::string base = c.base == RoverBaseSource::Dds ? "dds" : "file";
-  input.get("base", base);
-  if (base == "file") {
-    c.base = RoverBaseSource::File;
-  } else if (base == "dds") {
-    c.base = RoverBaseSource::Dds;
+  std::string rover = c.rover == RoverInputKind::Ubx ? "ubx" : "rinex";
+  input.get("rover", rover);
+  if (rover == "rinex" || rover == "ubx") {
+    c.rover = rover == "ubx" ? RoverInputKind::Ubx : RoverInputKind::Rinex;
   } else {
-    input.fail("base", "must be file or dds, not '" + base + "'");
+    input.fail("rover", "must be rinex or ubx, not '" + rover + "'");
   }
+  input.get("rover_source", c.rover_source);
+  c.rover_source = resolve_link(c.rover_source, file);
+  if (auto a = LinkAddress::parse(c.rover_source); !c.rover_source.empty() && !a)
+    input.fail("rover_source", a.error().message);
+  std::string base = rover_base_source_name(c.base);
+  input.get("base", base);
+  const auto* known =
+      std::find_if(kBaseSources.begin(), kBaseSources.end(), [&](const auto& s) { return base == s.second; });
+  if (known != kBaseSources.end()) {
+    c.base = known->first;
+  } else {
+    input.fail("base", "must be file, dds, ntrip or tcp, not '" + base + "'");
+  }
+  input.get("base_source", c.base_source);
+  if (auto a = LinkAddress::parse(c.base_source); !c.base_source.empty() && !a)
+    input.fail("base_source", a.error().message);
+  input.get("stream_ephemerides", c.stream_ephemerides);
+  input.get("link_attempts", c.link.attempts);
+  input.get("link_stall_timeout_s", c.link.stall_timeout_s);
   input.get("base_wait_s", c.base_wait_s);
   int frames = static_cast<int>(c.base_queue_frames);
   input.get("base_queue_frames", frames);
@@ -86,7 +153,13 @@ std::string to_yaml(const RoverConfig& c) {
   out << YAML::Key << "rover_id" << YAML::Value << c.rover_id;
   out << YAML::Key << "input" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "pace" << YAML::Value << c.pace;
-  out << YAML::Key << "base" << YAML::Value << (c.base == RoverBaseSource::Dds ? "dds" : "file");
+  out << YAML::Key << "rover" << YAML::Value << (c.rover == RoverInputKind::Ubx ? "ubx" : "rinex");
+  out << YAML::Key << "rover_source" << YAML::Value << c.rover_source;
+  out << YAML::Key << "base" << YAML::Value << rover_base_source_name(c.base);
+  out << YAML::Key << "base_source" << YAML::Value << c.base_source;
+  out << YAML::Key << "stream_ephemerides" << YAML::Value << c.stream_ephemerides;
+  out << YAML::Key << "link_attempts" << YAML::Value << c.link.attempts;
+  out << YAML::Key << "link_stall_timeout_s" << YAML::Value << c.link.stall_timeout_s;
   out << YAML::Key << "base_wait_s" << YAML::Value << c.base_wait_s;
   out << YAML::Key << "base_queue_frames" << YAML::Value << c.base_queue_frames;
   out << YAML::EndMap;

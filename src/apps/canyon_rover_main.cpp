@@ -21,6 +21,7 @@
 #include "canyon/app/observation_stream.hpp"
 #include "canyon/app/process.hpp"
 #include "canyon/app/rover_config.hpp"
+#include "canyon/app/rover_ingest.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/pipeline/dds.hpp"
@@ -52,76 +53,95 @@ struct BaseFrameSample {
   std::int64_t send_ns = 0;
 };
 
-/// Ingest: the rover file at its pace; the base from a file (BaseCursor) or from DDS (LiveBaseCursor).
-class RoverSource final : public app::EpochSource {
- public:
-  RoverSource(app::ObservationStream rover, double pace, std::optional<app::BaseCursor> file_base,
-              moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>* dds_frames, double base_wait_s)
-      : rover_(std::move(rover)),
-        pace_(pace),
-        file_base_(std::move(file_base)),
-        dds_frames_(dds_frames),
-        base_wait_ns_(static_cast<std::int64_t>(base_wait_s * 1e9)) {}
-
-  Result<std::optional<app::EpochItem>> next() override {
-    auto next = rover_.next();
-    if (!next) return next.error();
-    if (!*next) return std::optional<app::EpochItem>{};
-    std::optional<app::EpochItem> item(std::in_place);
-    item->rover = std::move(**next);
-    const core::GpsTime t = item->rover.time;
-    if (!wait_until_due(t)) return std::optional<app::EpochItem>{};  // stopped
-    if (file_base_) {
-      auto base = file_base_->at(t);
-      if (!base) return base.error();
-      if (*base != nullptr) item->base = **base;
-    } else if (dds_frames_ != nullptr) {
-      if (!live_) {
-        live_.emplace(t, [this](std::int64_t timeout_us) { return poll(timeout_us); });
-      }
-      const app::LiveBaseCursor::Match match = live_->at(t, core::pipeline_now_ns() + base_wait_ns_);
-      if (match.late) base_late_.fetch_add(1);
-      if (match.epoch != nullptr) item->base = *match.epoch;
-      item->base_send_ns = match.send_ns;
-    }
-    item->arrival_ns = core::pipeline_now_ns();  // the epoch is complete (rover and base) and enters the stages
-    return item;
-  }
-
-  [[nodiscard]] std::uint64_t base_late() const { return base_late_.load(); }
-
- private:
-  /// Sleeps until the rover epoch at t is due at the replay pace; false if stopped meanwhile.
-  bool wait_until_due(const core::GpsTime& t) {
-    if (!(pace_ > 0.0)) return !g_stop.load();
-    const std::int64_t now = core::pipeline_now_ns();
-    if (!first_) first_ = std::make_pair(t, now);
-    const auto due = first_->second + static_cast<std::int64_t>((t - first_->first) / pace_ * 1e9);
-    while (!g_stop.load()) {
-      const std::int64_t left = due - core::pipeline_now_ns();
-      if (left <= 0) return true;
-      std::this_thread::sleep_for(std::chrono::nanoseconds(std::min<std::int64_t>(left, 50'000'000)));
-    }
-    return false;
-  }
-
-  bool poll(std::int64_t timeout_us) {
+/// The DDS base: the RtcmFrame samples the listener queued, into the live base cursor.
+app::BaseInput::PollFn dds_base_poll(moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& frames) {
+  return [&frames](std::int64_t timeout_us, app::LiveBaseCursor& cursor) {
     BaseFrameSample frame;
-    if (!dds_frames_->wait_dequeue_timed(frame, timeout_us)) return !g_stop.load();
-    live_->push(frame.bytes, frame.send_ns);
-    while (dds_frames_->try_dequeue(frame)) live_->push(frame.bytes, frame.send_ns);
+    if (!frames.wait_dequeue_timed(frame, timeout_us)) return !g_stop.load();
+    cursor.push(frame.bytes, frame.send_ns);
+    while (frames.try_dequeue(frame)) cursor.push(frame.bytes, frame.send_ns);
     return true;
-  }
+  };
+}
 
-  app::ObservationStream rover_;
-  double pace_;
-  std::optional<app::BaseCursor> file_base_;
-  moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>* dds_frames_;
-  std::int64_t base_wait_ns_;
-  std::optional<app::LiveBaseCursor> live_;
-  std::optional<std::pair<core::GpsTime, std::int64_t>> first_;
-  std::atomic<std::uint64_t> base_late_{0};
-};
+void log_warning(const std::string& text) {
+  spdlog::warn("{}", text);
+}
+
+/// A link's events, prefixed with its role ("rover", "base").
+app::ByteLink::LogFn link_log(const std::string& role) {
+  return [role](bool problem, const std::string& text) {
+    if (problem) {
+      spdlog::warn("{} {}", role, text);
+    } else {
+      spdlog::info("{} {}", role, text);
+    }
+  };
+}
+
+/// The rover's input: the RINEX file (estimator.rover) or the receiver link (input.rover_source).
+Result<app::RoverInput> open_rover(const app::RoverConfig& config, const canyon::io::ObsFilter& filter) {
+  app::RoverInput input;
+  if (config.rover == app::RoverInputKind::Ubx) {
+    auto address = app::LinkAddress::parse(config.rover_source);
+    if (!address) return address.error();
+    auto link = app::ByteLink::open(*address, config.link, link_log("rover"));
+    if (!link) return link.error();
+    input.receiver = std::make_unique<app::ReceiverStream>(std::move(*link), filter, log_warning);
+    input.paced = address->kind == app::LinkAddress::Kind::File;
+    return input;
+  }
+  auto rover = app::ObservationStream::open(config.estimator.rover_obs, filter);
+  if (!rover) return rover.error();
+  input.rinex.emplace(std::move(*rover));
+  return input;
+}
+
+/// The base's input and position: the RINEX file (position from estimator.base_position or its header), or a
+/// stream (DDS frames, an NTRIP or TCP link; position from estimator.base_position).
+Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::io::ObsFilter& filter,
+                                 const std::optional<core::GpsTime>& rover_start,
+                                 moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& dds_frames,
+                                 Eigen::Vector3d& p_E_base) {
+  const app::ProcessConfig& est = config.estimator;
+  app::BaseInput input;
+  if (est.base_position_E_m) p_E_base = *est.base_position_E_m;
+  switch (config.base) {
+    case app::RoverBaseSource::File: {
+      auto base = app::ObservationStream::open(est.base_obs, filter, rover_start);
+      if (!base) return base.error();
+      if (!est.base_position_E_m) {
+        if (!base->header().receiver.approx_position_E_m) {
+          return canyon::Error{"no base position: give estimator.base_position", est.base_obs, 0};
+        }
+        p_E_base = *base->header().receiver.approx_position_E_m;
+      }
+      input.file.emplace(std::move(*base));
+      return input;
+    }
+    case app::RoverBaseSource::Dds:
+      input.poll = dds_base_poll(dds_frames);
+      input.name = "base DDS " + config.rtcm_topic;
+      break;
+    case app::RoverBaseSource::Ntrip:
+    case app::RoverBaseSource::Tcp: {
+      auto address = app::LinkAddress::parse(config.base_source);
+      if (!address) return address.error();
+      auto link = app::ByteLink::open(*address, config.link, link_log("base"));
+      if (!link) return link.error();
+      std::shared_ptr<app::ByteLink> shared(std::move(*link));
+      input.poll = app::link_base_poll(shared, log_warning);
+      input.name = "base " + address->text;
+      input.link = std::move(shared);
+      break;
+    }
+  }
+  if (!est.base_position_E_m) {
+    return canyon::Error{std::string("input.base ") + app::rover_base_source_name(config.base) +
+                         " needs estimator.base_position (the base's ECEF antenna position)"};
+  }
+  return input;
+}
 
 int run(int argc, char** argv) {
   CLI::App cli{"canyon-rover: the real-time rover pipeline (six stage threads, DDS in and out)"};
@@ -174,6 +194,15 @@ int run(int argc, char** argv) {
   }
   const app::ProcessConfig& est = config->estimator;
   const bool dds_base = config->base == app::RoverBaseSource::Dds;
+  const auto shown = [](const std::string& link) {  // a link as messages show it (no password)
+    auto address = app::LinkAddress::parse(link);
+    return address ? address->text : link;
+  };
+  const std::string rover_from =
+      config->rover == app::RoverInputKind::Ubx ? shown(config->rover_source) : est.rover_obs;
+  const std::string base_from = config->base == app::RoverBaseSource::File ? est.base_obs
+                                : dds_base                                 ? "DDS " + config->rtcm_topic
+                                                                           : shown(config->base_source);
 
   // DDS first: profiles before any participant.
   std::string profiles = config->profiles;
@@ -252,39 +281,26 @@ int run(int argc, char** argv) {
 
   // The estimator, as canyon process builds it.
   app::ProcessSummary notes;
-  auto nav = app::load_navigation(est.nav, notes.warnings);
+  // No navigation file: the ephemerides come from the streams only (RoverConfig::validate checks they can).
+  auto nav = est.nav.empty() ? Result<core::NavigationData>(core::NavigationData{})
+                             : app::load_navigation(est.nav, notes.warnings);
   if (!nav) {
     spdlog::error("{}", nav.error().to_string());
     return kExitRuntime;
   }
-  const canyon::gnss::EphemerisStore ephemerides(std::move(*nav));
+  canyon::gnss::EphemerisStore ephemerides(std::move(*nav));  // grows by the streams' ephemerides (EphemerisFeed)
   const canyon::io::ObsFilter filter = app::process_observation_filter(est);
-  auto rover = app::ObservationStream::open(est.rover_obs, filter);
+  auto rover = open_rover(*config, filter);
   if (!rover) {
     spdlog::error("{}", rover.error().to_string());
     return kExitRuntime;
   }
-  std::optional<app::BaseCursor> file_base;
+  const std::optional<core::GpsTime> rover_start =
+      rover->rinex ? rover->rinex->header().first_obs : std::optional<core::GpsTime>{};
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
-  if (!dds_base) {
-    auto base = app::ObservationStream::open(est.base_obs, filter, rover->header().first_obs);
-    if (!base) {
-      spdlog::error("{}", base.error().to_string());
-      return kExitRuntime;
-    }
-    if (est.base_position_E_m) {
-      p_E_base = *est.base_position_E_m;
-    } else if (base->header().receiver.approx_position_E_m) {
-      p_E_base = *base->header().receiver.approx_position_E_m;
-    } else {
-      spdlog::error("{}: no base position: give estimator.base_position", est.base_obs);
-      return kExitUsage;
-    }
-    file_base.emplace(std::move(*base));
-  } else if (est.base_position_E_m) {
-    p_E_base = *est.base_position_E_m;
-  } else {
-    spdlog::error("{}: input.base dds needs estimator.base_position (the base's ECEF antenna position)", config_file);
+  auto base = open_base(*config, filter, rover_start, base_frames, p_E_base);
+  if (!base) {
+    spdlog::error("{}: {}", config_file, base.error().to_string());
     return kExitUsage;
   }
   std::unique_ptr<canyon::rtk::RtkEngine> rtk_engine;
@@ -303,6 +319,7 @@ int run(int argc, char** argv) {
     rtk_engine = std::make_unique<canyon::rtk::RtkEngine>(est.rtk, ephemerides, p_E_base);
     estimator = std::make_unique<app::RtkEstimator>(*rtk_engine);
   }
+  app::EphemerisFeed feed(*estimator, ephemerides);
   for (const std::string& w : notes.warnings) spdlog::warn("{}", w);
   for (const std::string& r : notes.report) spdlog::info("{}", r);
 
@@ -316,8 +333,12 @@ int run(int argc, char** argv) {
     pos = std::move(*p);
   }
 
-  RoverSource source(std::move(*rover), config->pace, std::move(file_base), dds_base ? &base_frames : nullptr,
-                     config->base_wait_s);
+  app::RoverIngestOptions ingest_options;
+  ingest_options.pace = config->pace;
+  ingest_options.base_wait_s = config->base_wait_s;
+  ingest_options.stream_ephemerides = config->stream_ephemerides;
+  app::RoverIngest source(
+      std::move(*rover), std::move(*base), ingest_options, [] { return g_stop.load(); }, log_warning);
   std::uint64_t solved = 0, fixed = 0, epochs = 0;
   std::atomic<std::uint64_t> refused{0};  // the time bridge's and the ambiguity stage's threads publish
   const auto sink = [&](const app::EpochItem& item) -> Status {
@@ -365,7 +386,7 @@ int run(int argc, char** argv) {
     auto timing = pl::to_msg_timing(item, context);
     if (!(*timing_writer)->write(timing)) ++refused;
   };
-  app::EpochPipeline pipeline(source, *estimator, sink, config->pipeline, observer);
+  app::EpochPipeline pipeline(source, feed, sink, config->pipeline, observer);
   pipeline_ptr = &pipeline;
   g_pipeline.store(&pipeline);
   std::signal(SIGINT, on_signal);
@@ -383,10 +404,11 @@ int run(int argc, char** argv) {
                    wait_subscribers);
     }
   }
-  spdlog::info("rover '{}': {} mode, base from {}, {} pipeline, pace {}; publishing {} and {} on domain {}",
-               config->rover_id, app::mode_name(est.mode), dds_base ? "DDS " + config->rtcm_topic : est.base_obs,
-               config->pipeline.threaded ? "threaded" : "sequential", config->pace, config->solution_topic,
-               config->timing_topic, config->domain);
+  spdlog::info(
+      "rover '{}': {} mode, rover from {}, base from {}, {} pipeline, pace {}; publishing {} and {} on domain {}",
+      config->rover_id, app::mode_name(est.mode), rover_from, base_from,
+      config->pipeline.threaded ? "threaded" : "sequential", config->pace, config->solution_topic, config->timing_topic,
+      config->domain);
   const auto start = std::chrono::steady_clock::now();
   Status status = pipeline.run();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -402,9 +424,20 @@ int run(int argc, char** argv) {
     spdlog::warn("base: {} RTCM frames dropped (queue full), {} malformed", base_frames_dropped.load(),
                  base_frames_bad.load());
   }
+  for (const app::RoverIngest::Summary& s : source.summary()) {
+    if (s.problems) {
+      spdlog::warn("{}", s.text);
+    } else {
+      spdlog::info("{}", s.text);
+    }
+  }
   if (source.base_late() > 0) {
     spdlog::warn("base: {} epochs went on without waiting longer for their base epoch (input.base_wait_s {})",
                  source.base_late(), config->base_wait_s);
+  }
+  if (feed.added() > 0) {
+    spdlog::info("{} ephemerides from the streams (UBX SFRBX, RTCM 3) used besides the navigation files'",
+                 feed.added());
   }
   if (fusion_engine) {
     for (const std::string& line : fusion_engine->report()) spdlog::info("{}", line);

@@ -177,16 +177,45 @@ EphemerisStore::EphemerisStore(core::NavigationData nav, EphemerisOptions option
     : nav_(std::move(nav)), options_(options) {
   kepler_by_sat_.resize(core::kMaxSatellites);
   glonass_by_sat_.resize(core::kMaxSatellites);
-  for (int i = 0; i < static_cast<int>(nav_.kepler.size()); ++i) {
-    const core::KeplerEphemeris& e = nav_.kepler[i];
-    if (!e.sat.valid() || (!kepler_healthy(e) && !options_.use_unhealthy)) continue;
-    const double fit_s = e.fit_interval_h > 0.0 ? e.fit_interval_h * 3600.0 / 2.0 : 0.0;
-    kepler_by_sat_[e.sat.index()].push_back(
-        KeplerCandidate{e.toe, e.transmission_time, std::max(options_.max_age_kepler_s, fit_s), i, is_galileo_inav(e)});
+  for (int i = 0; i < static_cast<int>(nav_.kepler.size()); ++i) index_kepler(i);
+  for (int i = 0; i < static_cast<int>(nav_.glonass.size()); ++i) index_glonass(i);
+}
+
+void EphemerisStore::index_kepler(int i) {
+  const core::KeplerEphemeris& e = nav_.kepler[static_cast<std::size_t>(i)];
+  if (!e.sat.valid() || (!kepler_healthy(e) && !options_.use_unhealthy)) return;
+  const double fit_s = e.fit_interval_h > 0.0 ? e.fit_interval_h * 3600.0 / 2.0 : 0.0;
+  kepler_by_sat_[e.sat.index()].push_back(
+      KeplerCandidate{e.toe, e.transmission_time, std::max(options_.max_age_kepler_s, fit_s), i, is_galileo_inav(e)});
+}
+
+void EphemerisStore::index_glonass(int i) {
+  const core::GlonassEphemeris& e = nav_.glonass[static_cast<std::size_t>(i)];
+  if (e.sat.valid()) glonass_by_sat_[e.sat.index()].push_back(i);
+}
+
+int EphemerisStore::add(const core::NavigationData& fresh) {
+  int added = 0;
+  for (const core::KeplerEphemeris& e : fresh.kepler) {
+    const bool held = std::any_of(nav_.kepler.begin(), nav_.kepler.end(), [&e](const core::KeplerEphemeris& h) {
+      return h.sat == e.sat && h.toe == e.toe && h.iode == e.iode && is_galileo_inav(h) == is_galileo_inav(e);
+    });
+    if (held) continue;
+    nav_.kepler.push_back(e);
+    index_kepler(static_cast<int>(nav_.kepler.size()) - 1);
+    ++added;
   }
-  for (int i = 0; i < static_cast<int>(nav_.glonass.size()); ++i) {
-    if (nav_.glonass[i].sat.valid()) glonass_by_sat_[nav_.glonass[i].sat.index()].push_back(i);
+  for (const core::GlonassEphemeris& e : fresh.glonass) {
+    const bool held = std::any_of(nav_.glonass.begin(), nav_.glonass.end(),
+                                  [&e](const core::GlonassEphemeris& h) { return h.sat == e.sat && h.toe == e.toe; });
+    if (held) continue;
+    nav_.glonass.push_back(e);
+    index_glonass(static_cast<int>(nav_.glonass.size()) - 1);
+    ++added;
   }
+  if (!nav_.gps_klobuchar) nav_.gps_klobuchar = fresh.gps_klobuchar;
+  if (!nav_.bds_klobuchar) nav_.bds_klobuchar = fresh.bds_klobuchar;
+  return added;
 }
 
 const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat, core::GpsTime t) const {

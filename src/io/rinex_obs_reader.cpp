@@ -930,4 +930,19 @@ Result<RinexObsFile> read_rinex_obs(const std::string& path, std::optional<ObsFi
   return file;
 }
 
+void apply_obs_filter(const ObsFilter& filter, core::ObsEpoch& epoch) {
+  const auto kept_signal = [&filter](core::Constellation system, const core::SignalObs& signal) {
+    const auto rank = core::frequency_rank(system, signal.code.band);
+    return rank && *rank <= filter.max_frequency_rank;
+  };
+  for (core::SatelliteObs& sat : epoch.sats) {
+    if (!filter.systems.uses(sat.sat.system)) {
+      sat.signals.clear();
+      continue;
+    }
+    std::erase_if(sat.signals, [&](const core::SignalObs& s) { return !kept_signal(sat.sat.system, s); });
+  }
+  std::erase_if(epoch.sats, [](const core::SatelliteObs& sat) { return sat.signals.empty(); });
+}
+
 }  // namespace canyon::io

@@ -195,6 +195,62 @@ TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
   for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
 }
 
+/// Counts the epochs between the time bridge and the ambiguity stage; add_navigation() must find none.
+class InFlightEstimator final : public EpochEstimator {
+ public:
+  void bridge(EpochItem& /*item*/) const override { in_flight_.fetch_add(1); }
+  void align(EpochItem& /*item*/) override {}
+  void predict(EpochItem& item) override { item.to_update = true; }
+  void update(EpochItem& item) override { item.to_resolve = true; }
+  void resolve(EpochItem& item) override {
+    std::this_thread::sleep_for(std::chrono::microseconds(100));  // the later stages lag: epochs pile up
+    item.output.emplace();
+    in_flight_.fetch_sub(1);
+  }
+  void finish() override {}
+  void add_navigation(const core::NavigationData& fresh) override {
+    EXPECT_EQ(in_flight_.load(), 0) << "ephemerides added while a stage may read them";
+    added += fresh.kepler.size();
+  }
+  std::size_t added = 0;
+
+ private:
+  mutable std::atomic<int> in_flight_{0};
+};
+
+// Ephemerides that arrive with an epoch are handed to the estimator once every earlier epoch has left the last
+// stage, in both modes, each once.
+TEST(EpochPipeline, EphemeridesAreAddedWhileNoStageRuns) {
+  for (const bool threaded : {true, false}) {
+    CountingSource counting(200, std::chrono::microseconds(0));
+    struct WithNavigation final : EpochSource {
+      explicit WithNavigation(CountingSource& s) : source(s) {}
+      Result<std::optional<EpochItem>> next() override {
+        auto item = source.next();
+        if (item && *item && source.produced_.load() % 10 == 0) {
+          auto nav = std::make_shared<core::NavigationData>();
+          nav->kepler.resize(2);
+          (*item)->navigation = std::move(nav);
+        }
+        return item;
+      }
+      CountingSource& source;
+    } source(counting);
+    InFlightEstimator estimator;
+    std::size_t solved = 0;
+    EpochPipeline pipeline(
+        source, estimator,
+        [&solved](const EpochItem&) -> Status {
+          ++solved;
+          return Ok{};
+        },
+        PipelineOptions{threaded, 8});
+    ASSERT_TRUE(pipeline.run().ok());
+    EXPECT_EQ(solved, 200U) << threaded;
+    EXPECT_EQ(estimator.added, 40U) << threaded;  // 20 epochs with 2 records each
+  }
+}
+
 TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
   CountingSource source(20, std::chrono::milliseconds(2));
   RecordingEstimator estimator;

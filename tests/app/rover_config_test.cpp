@@ -27,7 +27,7 @@ TEST(RoverConfig, TyposAndBrokenRulesAreErrors) {
   };
   EXPECT_NE(error("rover_id: x\n").find("'estimator:'"), std::string::npos);
   EXPECT_NE(error(estimator + "input: {pase: 1}\n").find("pase"), std::string::npos);
-  EXPECT_NE(error(estimator + "input: {base: ntrip}\n").find("file or dds"), std::string::npos);
+  EXPECT_NE(error(estimator + "input: {base: udp}\n").find("file, dds, ntrip or tcp"), std::string::npos);
   EXPECT_NE(error(estimator + "pipeline: {queue_capacity: 0}\n").find("queue_capacity"), std::string::npos);
   EXPECT_NE(error(estimator + "dds: {domain: 300}\n").find("dds.domain"), std::string::npos);
   EXPECT_NE(error(estimator + "input: {pace: -1}\n").find("input.pace"), std::string::npos);
@@ -36,6 +36,50 @@ TEST(RoverConfig, TyposAndBrokenRulesAreErrors) {
       error("estimator: {mode: rtk, rover: r.obs, nav: [n.rnx], rtk: {ratio_treshold: 3}}\n").find("ratio_treshold"),
       std::string::npos);
   EXPECT_EQ(error("estimator: {mode: rtk, rover: r.obs, nav: [n.rnx]}\ninput: {base: dds}\n"), "");
+}
+
+TEST(RoverConfig, ReceiverAndNetworkInputs) {
+  const auto parse = [](const std::string& yaml) { return parse_rover_config(YAML::Load(yaml), "/cfg/rover.yaml"); };
+  const auto error = [&parse](const std::string& yaml) {
+    auto c = parse(yaml);
+    if (!c) return c.error().to_string();
+    return c->validate();
+  };
+  // A u-blox rover from a file relative to the configuration, the base from NTRIP, ephemerides from the streams.
+  auto c = parse(
+      "estimator: {mode: rtk, nav: [], base_position: [1, 2, 3]}\n"
+      "input: {rover: ubx, rover_source: 'file:logs/rover.ubx', base: ntrip, base_source: 'ntrip://u:p@h:2101/M',\n"
+      "        link_attempts: 0, link_stall_timeout_s: 3}\n");
+  ASSERT_TRUE(c) << c.error().to_string();
+  EXPECT_EQ(c->validate(), "");
+  EXPECT_EQ(c->rover, RoverInputKind::Ubx);
+  EXPECT_EQ(c->rover_source, "file:/cfg/logs/rover.ubx");
+  EXPECT_EQ(c->base, RoverBaseSource::Ntrip);
+  EXPECT_EQ(c->link.attempts, 0);
+  EXPECT_EQ(c->link.stall_timeout_s, 3.0);
+  auto again = parse_rover_config(YAML::Load(to_yaml(*c)), "printed");
+  ASSERT_TRUE(again) << again.error().to_string();
+  EXPECT_TRUE(*again == *c);
+
+  const std::string est = "estimator: {mode: rtk, rover: r.obs, nav: [n.rnx], base_position: [1, 2, 3]}\n";
+  EXPECT_EQ(error(est + "input: {base: tcp, base_source: 'tcp://127.0.0.1:2102'}\n"), "");
+  EXPECT_NE(error(est + "input: {base: tcp}\n").find("input.base_source is required"), std::string::npos);
+  EXPECT_NE(error(est + "input: {base: ntrip, base_source: 'tcp://h:1'}\n").find("must be ntrip://"),
+            std::string::npos);
+  EXPECT_NE(error(est + "input: {rover: ubx, base: dds}\n").find("input.rover_source is required"), std::string::npos);
+  EXPECT_NE(error(est + "input: {rover: sbf}\n").find("rinex or ubx"), std::string::npos);
+  EXPECT_NE(error(est + "input: {base: dds, link_attempts: -1}\n").find("input.link_attempts"), std::string::npos);
+  // A malformed address is an error naming the file, the line and the key.
+  const std::string bad = error(est + "input:\n  rover: ubx\n  rover_source: 'usb:/dev/x'\n");
+  EXPECT_NE(bad.find("/cfg/rover.yaml:4"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("input.rover_source"), std::string::npos) << bad;
+  // No ephemerides anywhere.
+  EXPECT_NE(error("estimator: {mode: rtk, rover: r.obs, base: b.obs, nav: []}\n").find("navigation file"),
+            std::string::npos);
+  EXPECT_NE(error("estimator: {mode: rtk, nav: [], base_position: [1, 2, 3]}\n"
+                  "input: {rover: ubx, rover_source: 'file:r.ubx', base: dds, stream_ephemerides: false}\n")
+                .find("navigation file"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -207,6 +207,38 @@ TEST(Ephemeris, SelectionRules) {
   EXPECT_EQ(fnav_only.select_kepler(inav.sat, inav.toe + 300.0)->iode, 2);
 }
 
+// Ephemerides that arrive while running (a receiver's SFRBX, a base's RTCM) are added unless the store holds the
+// same record: the selection then is that of a store built with all of them, and a repeat changes nothing.
+TEST(Ephemeris, AddedRecordsAreSelectedAndRepeatsKeepTheHeldRecord) {
+  core::KeplerEphemeris a = gps_g05(), b = gps_g05();
+  a.toe = a.toc = {2320, 115200.0};
+  a.iode = 10;
+  b.toe = b.toc = {2320, 122400.0};
+  b.iode = 11;
+  EphemerisStore store = store_of({a});
+  EXPECT_EQ(store.select_kepler(a.sat, {2320, 121000.0})->iode, 10);
+  core::NavigationData fresh;
+  fresh.kepler = {a, b};
+  fresh.kepler[0].af0_s += 1e-3;  // same satellite, toe and IODE as the held record: not added
+  fresh.gps_klobuchar = core::KlobucharParams{};
+  EXPECT_EQ(store.add(fresh), 1);
+  EXPECT_EQ(store.nav().kepler.size(), 2u);
+  EXPECT_EQ(store.select_kepler(a.sat, {2320, 121000.0})->iode, 11);        // the added, nearer toe
+  EXPECT_EQ(store.select_kepler(a.sat, {2320, 116000.0})->af0_s, a.af0_s);  // the held record, unchanged
+  EXPECT_TRUE(store.nav().gps_klobuchar.has_value());
+  EXPECT_EQ(store.add(fresh), 0);  // a repeat adds nothing
+
+  // Unhealthy records are kept but not selected, as in a store built with them.
+  core::KeplerEphemeris sick = gps_g05();
+  sick.toe = sick.toc = {2320, 118800.0};
+  sick.iode = 12;
+  sick.health = 1;
+  core::NavigationData more;
+  more.kepler = {sick};
+  EXPECT_EQ(store.add(more), 1);
+  EXPECT_NE(store.select_kepler(a.sat, {2320, 118800.0})->iode, 12);
+}
+
 TEST(Ephemeris, QzssL1cbHealthBitDoesNotRejectTheSatellite) {
   // QZSS LNAV health bit 0 is the L1C/B signal's (set on every QZSS record of matrtklib-static); other bits count.
   core::KeplerEphemeris qzs = gps_g05();

@@ -21,6 +21,8 @@
 // Queue policy: GNSS epochs are never dropped. A full queue blocks its producer (back-pressure up to ingest, which
 // then reads its input later); each time a producer finds its queue full is counted (PipelineStats::full_waits).
 // Stop (stop()): ingest stops reading; every epoch already ingested goes through every stage and reaches the sink.
+// Ephemerides that arrive while running (EpochItem::navigation, rare: a satellite's new ephemeris every hour or two)
+// drain the pipeline: that epoch enters the time bridge once every earlier epoch has left the last stage.
 
 #include <array>
 #include <atomic>
@@ -32,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "canyon/core/ephemeris.hpp"
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
@@ -84,6 +87,11 @@ struct EpochItem {
   std::int64_t arrival_ns = 0;    ///< the epoch complete at ingest, rover and base (pipeline clock; 0: the pipeline
                                   ///< stamps it when the source returns it); the ingest stage is timed from it
   std::int64_t base_send_ns = 0;  ///< the base's send time of its epoch's last frame (DDS base; 0 otherwise)
+  /// Ephemerides that arrived on the rover's or the base's stream before this epoch (nullptr: none). The pipeline
+  /// hands them to EpochEstimator::add_navigation() before the epoch's time bridge, once every earlier epoch has
+  /// left the last stage: no stage reads the ephemerides meanwhile, and threaded and sequential runs use the same
+  /// ephemerides for the same epoch.
+  std::shared_ptr<const core::NavigationData> navigation;
   std::array<std::int64_t, kNumStages> enter_ns{};  ///< per stage (pipeline clock)
   std::array<std::int64_t, kNumStages> exit_ns{};
   std::optional<fusion::VioPoseAt> pose;       ///< time bridge (fusion)
@@ -115,6 +123,9 @@ class EpochEstimator {
   virtual void resolve(EpochItem& item) = 0;
   /// End of the input (a pending alignment).
   virtual void finish() = 0;
+  /// Ephemerides that arrived while running (EpochItem::navigation), for the store the stages read. The pipeline
+  /// calls it while no stage runs (see EpochItem::navigation). Default: ignored.
+  virtual void add_navigation(const core::NavigationData& /*fresh*/) {}
 };
 
 /// RTK (rtk::RtkEngine): no VIO and no alignment; the time bridge builds each epoch's geometry (single-point
@@ -194,6 +205,8 @@ class EpochPipeline {
   /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
   void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
   void run_stage(Stage stage, EpochItem& item);
+  /// Waits until every epoch before `item` has left the last stage, then hands its ephemerides to the estimator.
+  void add_navigation(const EpochItem& item);
   void fail(const Error& error);
 
   EpochSource& source_;

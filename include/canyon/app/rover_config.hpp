@@ -6,13 +6,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "canyon/app/byte_link.hpp"
 #include "canyon/app/epoch_pipeline.hpp"
 #include "canyon/app/process_config.hpp"
 #include "canyon/core/result.hpp"
 
 namespace canyon::app {
 
-enum class RoverBaseSource { File, Dds };
+enum class RoverInputKind { Rinex, Ubx };
+enum class RoverBaseSource { File, Dds, Ntrip, Tcp };
+[[nodiscard]] const char* rover_base_source_name(RoverBaseSource source);
 
 struct RoverConfig {
   /// The estimator and its inputs: the keys of `canyon process` (mode rtk or fusion, rover, base, nav, vio,
@@ -20,8 +23,13 @@ struct RoverConfig {
   ProcessConfig estimator;
   std::string rover_id = "rover";  ///< names the rover in its messages
   double pace = 1.0;               ///< rover file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible
-  RoverBaseSource base = RoverBaseSource::File;  ///< file: estimator.base; dds: RtcmFrame samples
-  double base_wait_s = 2.0;  ///< how long a rover epoch waits for its base epoch (dds) before going on without
+  RoverInputKind rover = RoverInputKind::Rinex;  ///< rinex: estimator.rover; ubx: a u-blox receiver at rover_source
+  std::string rover_source;  ///< ubx: file:PATH (replayed at pace), serial:///dev/X?baud=N, tcp://HOST:PORT, ntrip://
+  RoverBaseSource base = RoverBaseSource::File;  ///< file: estimator.base; dds: RtcmFrame samples; ntrip, tcp: RTCM 3
+  std::string base_source;         ///< ntrip: ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT; tcp: tcp://HOST:PORT
+  bool stream_ephemerides = true;  ///< add the ephemerides of the UBX (SFRBX) and RTCM streams to estimator.nav's
+  LinkOptions link;                ///< attempts, stall_timeout_s of the network links (rover and base)
+  double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (dds) before going on without
   std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
   PipelineOptions pipeline{true, 64};    ///< threaded, queue_capacity
   int domain = 0;                        ///< DDS domain id
@@ -33,6 +41,8 @@ struct RoverConfig {
 
   /// Empty if usable, else the first broken rule.
   [[nodiscard]] std::string validate() const;
+  /// Whether the base comes as RTCM 3 that streams in (dds, ntrip, tcp).
+  [[nodiscard]] bool streamed_base() const { return base != RoverBaseSource::File; }
 };
 
 [[nodiscard]] bool operator==(const RoverConfig& a, const RoverConfig& b);

@@ -79,7 +79,17 @@ class EphemerisStore {
 
   [[nodiscard]] const core::NavigationData& nav() const { return nav_; }
 
+  /// Adds ephemerides that arrived while running (a receiver's or a base's stream): each record whose satellite,
+  /// toe and IODE (GLONASS: satellite and toe) the store has not got yet, and the ionosphere parameters the store
+  /// lacks. A record already held (from the navigation files, say) is kept, not replaced, so a stream repeating the
+  /// files' ephemerides changes no selection. The number of records added. Not thread-safe: no other thread may read
+  /// the store meanwhile (pointers from select_*() stay valid only until the next add()).
+  int add(const core::NavigationData& fresh);
+
  private:
+  void index_kepler(int i);
+  void index_glonass(int i);
+
   /// What selection reads of a usable (healthy, or use_unhealthy) Kepler record, kept contiguous per satellite so
   /// that a selection, done three times per satellite state, walks a short array instead of the records.
   struct KeplerCandidate {

@@ -58,6 +58,10 @@ struct ObsFilter {
   int max_frequency_rank = 2;        ///< signals of a higher frequency rank (or of no known rank) are skipped
 };
 
+/// The filter applied to an epoch from another source (a receiver's stream): the same satellites and signals a
+/// reader with `filter` keeps of the same observations; satellites left with no signal are removed.
+void apply_obs_filter(const ObsFilter& filter, core::ObsEpoch& epoch);
+
 class RinexObsReader {
  public:
   /// Opens the file and reads the header. Error (file and line) on unreadable, unsupported or malformed header.
