@@ -58,10 +58,9 @@ class RoverSource final : public app::EpochSource {
   RoverSource(app::ObservationStream rover, double pace, std::optional<app::BaseCursor> file_base,
               moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>* dds_frames, double base_wait_s)
       : rover_(std::move(rover)),
-        pace_(pace),
+        pacer_(pace, base_wait_s),
         file_base_(std::move(file_base)),
-        dds_frames_(dds_frames),
-        base_wait_ns_(static_cast<std::int64_t>(base_wait_s * 1e9)) {}
+        dds_frames_(dds_frames) {}
 
   Result<std::optional<app::EpochItem>> next() override {
     auto next = rover_.next();
@@ -79,7 +78,7 @@ class RoverSource final : public app::EpochSource {
       if (!live_) {
         live_.emplace(t, [this](std::int64_t timeout_us) { return poll(timeout_us); });
       }
-      const app::LiveBaseCursor::Match match = live_->at(t, core::pipeline_now_ns() + base_wait_ns_);
+      const app::LiveBaseCursor::Match match = live_->at(t, pacer_.base_deadline_ns(t, core::pipeline_now_ns()));
       if (match.late) base_late_.fetch_add(1);
       if (match.epoch != nullptr) item->base = *match.epoch;
       item->base_send_ns = match.send_ns;
@@ -93,10 +92,7 @@ class RoverSource final : public app::EpochSource {
  private:
   /// Sleeps until the rover epoch at t is due at the replay pace; false if stopped meanwhile.
   bool wait_until_due(const core::GpsTime& t) {
-    if (!(pace_ > 0.0)) return !g_stop.load();
-    const std::int64_t now = core::pipeline_now_ns();
-    if (!first_) first_ = std::make_pair(t, now);
-    const auto due = first_->second + static_cast<std::int64_t>((t - first_->first) / pace_ * 1e9);
+    const std::int64_t due = pacer_.due_ns(t, core::pipeline_now_ns());
     while (!g_stop.load()) {
       const std::int64_t left = due - core::pipeline_now_ns();
       if (left <= 0) return true;
@@ -114,12 +110,10 @@ class RoverSource final : public app::EpochSource {
   }
 
   app::ObservationStream rover_;
-  double pace_;
+  app::ReplayPacer pacer_;
   std::optional<app::BaseCursor> file_base_;
   moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>* dds_frames_;
-  std::int64_t base_wait_ns_;
   std::optional<app::LiveBaseCursor> live_;
-  std::optional<std::pair<core::GpsTime, std::int64_t>> first_;
   std::atomic<std::uint64_t> base_late_{0};
 };
 
