@@ -21,7 +21,7 @@ struct RoverConfig {
   std::string rover_id = "rover";  ///< names the rover in its messages
   double pace = 1.0;               ///< rover file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible
   RoverBaseSource base = RoverBaseSource::File;  ///< file: estimator.base; dds: RtcmFrame samples
-  double base_wait_s = 2.0;  ///< how long a rover epoch waits for its base epoch (dds) before going on without
+  double base_wait_s = 2.0;              ///< how long a rover epoch waits for its base epoch (dds), from when it is due
   std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
   PipelineOptions pipeline{true, 64};    ///< threaded, queue_capacity
   int domain = 0;                        ///< DDS domain id
