@@ -126,7 +126,8 @@ RoverIngest::RoverIngest(RoverInput rover, BaseInput base, RoverIngestOptions op
       base_(std::move(base)),
       options_(options),
       stopped_(std::move(stopped)),
-      warn_(std::move(warn)) {}
+      warn_(std::move(warn)),
+      pacer_(options.pace, options.base_wait_s) {}
 
 Result<std::optional<core::ObsEpoch>> RoverIngest::next_rover() {
   if (rover_.receiver) return rover_.receiver->next(stopped_);
@@ -149,9 +150,7 @@ Result<std::optional<EpochItem>> RoverIngest::next() {
 
 bool RoverIngest::wait_until_due(const core::GpsTime& t) {
   if (!rover_.paced || !(options_.pace > 0.0)) return !stopped_();
-  const std::int64_t now = core::pipeline_now_ns();
-  if (!first_) first_ = std::make_pair(t, now);
-  const auto due = first_->second + static_cast<std::int64_t>((t - first_->first) / options_.pace * 1e9);
+  const std::int64_t due = pacer_.due_ns(t, core::pipeline_now_ns());
   while (!stopped_()) {
     const std::int64_t left = due - core::pipeline_now_ns();
     if (left <= 0) return true;
@@ -173,8 +172,12 @@ Status RoverIngest::attach_base(EpochItem& item) {
     // Stopping ends the wait for the base at once (false: the base counts as ended).
     live_.emplace(t, [this](std::int64_t timeout_us) { return !stopped_() && base_.poll(timeout_us, *live_); });
   }
-  const std::int64_t wait_ns = static_cast<std::int64_t>(options_.base_wait_s * 1e9);
-  const LiveBaseCursor::Match match = live_->at(t, core::pipeline_now_ns() + wait_ns);
+  // The wait counts from when the epoch is due (a replay), or from now (a live receiver delivers it when due): an
+  // epoch that ingest reaches late, after an outage, does not wait a whole base_wait_s more.
+  const std::int64_t now = core::pipeline_now_ns();
+  const std::int64_t deadline =
+      rover_.paced ? pacer_.base_deadline_ns(t, now) : now + static_cast<std::int64_t>(options_.base_wait_s * 1e9);
+  const LiveBaseCursor::Match match = live_->at(t, deadline);
   base_problems_.report(base_.name, live_->decoder(), warn_);
   if (match.late) base_late_.fetch_add(1);
   if (match.epoch != nullptr) item.base = *match.epoch;

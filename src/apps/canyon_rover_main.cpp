@@ -431,6 +431,9 @@ int run(int argc, char** argv) {
       spdlog::info("{}", s.text);
     }
   }
+  if (pl::malformed_payloads() > 0) {
+    spdlog::warn("DDS: {} malformed samples dropped (packets corrupted on the way)", pl::malformed_payloads());
+  }
   if (source.base_late() > 0) {
     spdlog::warn("base: {} epochs went on without waiting longer for their base epoch (input.base_wait_s {})",
                  source.base_late(), config->base_wait_s);

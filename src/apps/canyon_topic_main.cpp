@@ -1,6 +1,7 @@
 // canyon-record, canyon-echo and canyon-monitor (one source, CANYON_TOOL selects): consumers of the rover's and
 // the base's DDS topics. `canyon record|echo|monitor ...` runs them.
-//   record TOPIC --out FILE: canyon/solution to .pos (RTKLIB format), .nmea (GGA) or .csv; canyon/rtcm to the raw
+//   record TOPIC --out FILE: canyon/solution to .pos (RTKLIB format), .nmea (GGA) or .csv (every sample, status 0
+//     too, with its sequence number and arrival time: the sequence accounting); canyon/rtcm to the raw
 //     RTCM 3 stream (replayable: canyon base input.kind rtcm3, canyon process base: FILE.rtcm3); canyon/timing and
 //     canyon/bridged to CSV.
 //   echo TOPIC: one line per sample.
@@ -177,7 +178,10 @@ int run(int argc, char** argv) {
     } else {
       raw.open(out, std::ios::binary | std::ios::trunc);
       if (!raw) return fail("cannot create " + out, kExitRuntime);
-      if (solutions) raw << "seq,gps_week,gps_tow_s,status,x_m,y_m,z_m,lat_deg,lon_deg,height_m,n_sats,ratio,age_s\n";
+      if (solutions) {
+        raw << "seq,gps_week,gps_tow_s,status,x_m,y_m,z_m,lat_deg,lon_deg,height_m,n_sats,ratio,age_s,"
+               "received_monotonic_ns\n";
+      }
     }
   }
   std::int64_t bad = 0;
@@ -204,6 +208,18 @@ int run(int argc, char** argv) {
       std::fflush(stdout);
       return;
     }
+    if (!pos && !nmea) {
+      // CSV: every sample, those without a solution (status 0) too, so that the sequence numbers account for every
+      // epoch; received_monotonic_ns is this recorder's clock (CLOCK_MONOTONIC, shared by a host's namespaces).
+      char line[360];
+      std::snprintf(line, sizeof line, "%llu,%d,%.3f,%d,%.4f,%.4f,%.4f,%.9f,%.9f,%.4f,%d,%.2f,%.2f,%lld\n",
+                    static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(), m.status(),
+                    m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2], m.lat_deg(), m.lon_deg(), m.height_m(),
+                    m.num_satellites(), m.ratio(), m.age_s(), static_cast<long long>(now));
+      raw << line << std::flush;  // followed live (a line a second): each sample reaches the file at once
+      if (m.status() != 0 && !pl::from_msg(m)) ++bad;
+      return;
+    }
     if (m.status() == 0) return;  // no solution: not a record
     auto s = pl::from_msg(m);
     if (!s) {
@@ -213,15 +229,8 @@ int run(int argc, char** argv) {
     }
     if (pos) {
       if (auto w = pos->write(*s); !w && error.empty()) error = w.error().to_string();
-    } else if (nmea) {
-      if (auto w = nmea->write(*s, m.hdop()); !w && error.empty()) error = w.error().to_string();
-    } else {
-      char line[320];
-      std::snprintf(line, sizeof line, "%llu,%d,%.3f,%d,%.4f,%.4f,%.4f,%.9f,%.9f,%.4f,%d,%.2f,%.2f\n",
-                    static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(), m.status(),
-                    m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2], m.lat_deg(), m.lon_deg(), m.height_m(),
-                    m.num_satellites(), m.ratio(), m.age_s());
-      raw << line;
+    } else if (auto w = nmea->write(*s, m.hdop()); !w && error.empty()) {
+      error = w.error().to_string();
     }
   };
   const auto on_timing = [&](canyon::msg::StageTiming&& m) {

@@ -7,6 +7,19 @@
 #include "canyon/app/shipped_config.hpp"
 
 namespace canyon::pipeline {
+namespace {
+
+std::atomic<std::uint64_t> g_malformed_payloads{0};
+
+}  // namespace
+
+std::uint64_t malformed_payloads() {
+  return g_malformed_payloads.load();
+}
+
+void detail::count_malformed_payload() {
+  g_malformed_payloads.fetch_add(1);
+}
 
 Result<std::string> default_profiles_file() {
   return app::find_shipped_config("dds/canyon_profiles.xml");

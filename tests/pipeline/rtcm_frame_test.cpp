@@ -69,6 +69,27 @@ int test_domain() {
   return 100 + static_cast<int>(::getpid() % 100);
 }
 
+// A packet corrupted on the way (here its CDR encapsulation) must be refused, not thrown through Fast DDS's listener
+// thread: the generated type support catches only NotEnoughMemoryException, and the rover died of
+// "Unexpected CDR type received in Cdr::read_encapsulation" in the fault suite's corruption run.
+TEST(RtcmFrameDds, CorruptedPayloadIsRefusedNotThrown) {
+  msg::RtcmFrame message = to_msg(sample_frame());
+  GuardedPubSubType<msg::RtcmFramePubSubType> guarded;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(guarded.m_typeSize);
+  ASSERT_TRUE(guarded.serialize(&message, &payload));
+  msg::RtcmFrame intact;
+  ASSERT_TRUE(guarded.deserialize(&payload, &intact));
+  EXPECT_EQ(intact.bytes(), message.bytes());
+
+  payload.data[1] = 0x7F;  // the representation identifier: no CDR kind
+  msg::RtcmFrame corrupted;
+  msg::RtcmFramePubSubType generated;
+  EXPECT_THROW((void)generated.deserialize(&payload, &corrupted), eprosima::fastcdr::exception::Exception);
+  const std::uint64_t before = malformed_payloads();
+  EXPECT_FALSE(guarded.deserialize(&payload, &corrupted));
+  EXPECT_EQ(malformed_payloads(), before + 1);
+}
+
 TEST(RtcmFrameDds, EverySubscriberReceivesEveryFrameOfCanyonBase) {
   const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "cssrlib-static-doy078";
   if (!fs::exists(data / "3034078M1.21O")) GTEST_SKIP() << "shared datasets not found at " << CANYON_SHARED_DATA_DIR;

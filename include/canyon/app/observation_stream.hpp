@@ -132,6 +132,37 @@ class BaseCursor {
   bool primed_ = false;
 };
 
+/// The pacing of a rover file replayed as a live receiver (canyon rover): epoch t is due at the instant the first
+/// epoch was read plus (t - first) / pace. A live base's epoch for t is waited for until due + base_wait: counted from
+/// when the epoch is due, not from when ingest gets to it, so a base outage delays every epoch by at most base_wait
+/// instead of adding one whole wait per epoch (the rover would fall further behind real time with every epoch of the
+/// outage). Pace 0 (as fast as possible, the rover follows the base): every epoch is due at once and waits from then.
+class ReplayPacer {
+ public:
+  ReplayPacer(double pace, double base_wait_s)
+      : pace_(pace), base_wait_ns_(static_cast<std::int64_t>(base_wait_s * 1e9)) {}
+
+  /// When epoch t is due (monotonic ns); the first call anchors the replay at (t, now_ns).
+  [[nodiscard]] std::int64_t due_ns(const core::GpsTime& t, std::int64_t now_ns) {
+    if (!(pace_ > 0.0)) return now_ns;
+    if (!anchor_) anchor_ = Anchor{t, now_ns};
+    return anchor_->ns + static_cast<std::int64_t>((t - anchor_->t) / pace_ * 1e9);
+  }
+  /// Until when epoch t waits for its base epoch (monotonic ns); may already have passed when ingest is behind.
+  [[nodiscard]] std::int64_t base_deadline_ns(const core::GpsTime& t, std::int64_t now_ns) {
+    return due_ns(t, now_ns) + base_wait_ns_;
+  }
+
+ private:
+  struct Anchor {
+    core::GpsTime t;
+    std::int64_t ns = 0;
+  };
+  double pace_;
+  std::int64_t base_wait_ns_;
+  std::optional<Anchor> anchor_;
+};
+
 /// A base whose RTCM 3 frames stream in (DDS, NTRIP, TCP). Frames are decoded as they come; at(t) waits until the base
 /// reached rover time t (a base epoch at or after t - kBaseToleranceS), or until the deadline, and then returns the
 /// latest base epoch not later than t + kBaseToleranceS, as BaseCursor does. The two agree whenever every base epoch

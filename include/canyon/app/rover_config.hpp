@@ -29,7 +29,7 @@ struct RoverConfig {
   std::string base_source;         ///< ntrip: ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT; tcp: tcp://HOST:PORT
   bool stream_ephemerides = true;  ///< add the ephemerides of the UBX (SFRBX) and RTCM streams to estimator.nav's
   LinkOptions link;                ///< attempts, stall_timeout_s of the network links (rover and base)
-  double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (dds) before going on without
+  double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (streamed), from when it is due
   std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
   PipelineOptions pipeline{true, 64};    ///< threaded, queue_capacity
   int domain = 0;                        ///< DDS domain id

@@ -142,7 +142,7 @@ class RoverIngest final : public EpochSource {
   std::optional<LiveBaseCursor> live_;
   NavigationCursor base_navigation_;
   ProblemReporter base_problems_;
-  std::optional<std::pair<core::GpsTime, std::int64_t>> first_;
+  ReplayPacer pacer_;  // when a replayed rover epoch is due, and until when it waits for its base
   std::atomic<std::uint64_t> base_late_{0};
 };
 

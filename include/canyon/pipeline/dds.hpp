@@ -8,12 +8,14 @@
 // created and the entity is created from it; QoS set in code would be overwritten or would override it).
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 
+#include <fastcdr/exceptions/Exception.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -25,6 +27,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/common/SerializedPayload.h>
 
 #include "canyon/core/result.hpp"
 
@@ -55,13 +58,38 @@ class DdsParticipant {
   std::mutex mutex_;
 };
 
+/// Payloads a reader could not deserialize (malformed CDR: a packet corrupted on the way), in this process.
+std::uint64_t malformed_payloads();
+
+namespace detail {
+void count_malformed_payload();
+}  // namespace detail
+
+/// A fastddsgen PubSubType whose deserialize() refuses a malformed payload instead of throwing. The generated code
+/// catches only NotEnoughMemoryException: a corrupted packet (e.g. a bad encapsulation) threw BadParamException
+/// through Fast DDS's listener thread and terminated the subscriber. Refused payloads are dropped by Fast DDS (with
+/// its "error deserializing" log line) and counted (malformed_payloads()).
+template <typename PubSub>
+class GuardedPubSubType final : public PubSub {
+ public:
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override {
+    try {
+      return PubSub::deserialize(payload, data);
+    } catch (const eprosima::fastcdr::exception::Exception&) {
+      detail::count_malformed_payload();
+      return false;
+    }
+  }
+};
+
 /// A writer of samples of type Msg (PubSub: the fastddsgen PubSubType) from a data_writer profile.
 template <typename Msg, typename PubSub>
 class DdsWriter {
  public:
   static Result<std::unique_ptr<DdsWriter>> create(DdsParticipant& participant, const std::string& topic_name,
                                                    const std::string& profile) {
-    auto topic = participant.topic(topic_name, fdds::TypeSupport(new PubSub()));
+    // Guarded too: the first registration of a type in a participant is the one its readers use.
+    auto topic = participant.topic(topic_name, fdds::TypeSupport(new GuardedPubSubType<PubSub>()));
     if (!topic) return topic.error();
     std::unique_ptr<DdsWriter> w(new DdsWriter(participant));
     w->publisher_ = participant.get()->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
@@ -112,7 +140,7 @@ class DdsReader {
   using SampleFn = std::function<void(Msg&&)>;
   static Result<std::unique_ptr<DdsReader>> create(DdsParticipant& participant, const std::string& topic_name,
                                                    const std::string& profile, SampleFn on_sample) {
-    auto topic = participant.topic(topic_name, fdds::TypeSupport(new PubSub()));
+    auto topic = participant.topic(topic_name, fdds::TypeSupport(new GuardedPubSubType<PubSub>()));
     if (!topic) return topic.error();
     std::unique_ptr<DdsReader> r(new DdsReader(participant, std::move(on_sample)));
     r->subscriber_ = participant.get()->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
