@@ -360,6 +360,7 @@ int run(int argc, char** argv) {
     }
     if (stage != app::Stage::Ambiguity) return;
     context.base_late = source.base_late();
+    context.malformed_samples = pl::malformed_payloads();
     context.vio_dropped = 0;
     if (pipeline_ptr != nullptr) {
       context.queue_depth = pipeline_ptr->queue_depths();

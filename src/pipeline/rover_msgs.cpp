@@ -106,6 +106,7 @@ msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& c
   m.queue_full_waits(waits);
   m.vio_dropped(context.vio_dropped);
   m.base_late(context.base_late);
+  m.malformed_samples(context.malformed_samples);
   m.alignment_rmse_m(context.alignment_rmse_m);
   m.alignment_eigen_ratio(context.alignment_eigen_ratio);
   m.lever_arm_m({context.lever_arm_m.x(), context.lever_arm_m.y(), context.lever_arm_m.z()});
@@ -262,6 +263,7 @@ app::TimingSample to_sample(const msg::StageTiming& m) {
   }
   s.vio_dropped = m.vio_dropped();
   s.base_late = m.base_late();
+  s.malformed_samples = m.malformed_samples();
   s.alignment_rmse_m = m.alignment_rmse_m();
   s.alignment_eigen_ratio = m.alignment_eigen_ratio();
   s.lever_arm_m = Eigen::Vector3d(m.lever_arm_m()[0], m.lever_arm_m()[1], m.lever_arm_m()[2]);

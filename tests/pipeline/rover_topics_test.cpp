@@ -46,6 +46,17 @@ void wait_for(const std::function<bool()>& done, double timeout_s = 10.0) {
   while (!done() && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(5));
 }
 
+TEST(RoverMsgs, TimingCarriesTheDropCounts) {
+  EpochContext context;
+  context.rover_id = "r1";
+  context.base_late = 3;
+  context.malformed_samples = 5;
+  const app::TimingSample t = to_sample(to_msg_timing(solved_item(2), context));
+  EXPECT_EQ(t.seq, 2U);
+  EXPECT_EQ(t.base_late, 3U);
+  EXPECT_EQ(t.malformed_samples, 5U);
+}
+
 TEST(RoverMsgs, SolutionRoundTripsBitForBit) {
   const app::EpochItem item = solved_item(7);
   EpochContext context;
@@ -164,6 +175,7 @@ TEST(MonitorModel, JsonLineCarriesTheSchema) {
   t.correction_age_s = 0.2;
   t.alignment_rmse_m = 0.02;
   t.alignment_eigen_ratio = 0.5;
+  t.malformed_samples = 4;
   model.add_timing(t);
   app::SolutionSample s;
   s.seq = 0;
@@ -177,7 +189,7 @@ TEST(MonitorModel, JsonLineCarriesTheSchema) {
   const std::string j = model.json_line(2'000'000'000);
   for (const char* key :
        {"\"t_s\":2.000", "\"stages\":{\"ingest\":{\"p50_us\":0.5", "\"end_to_end\":{\"p50_us\":6.5",
-        "\"correction_age_s\":0.200", "\"queues\":{", R"("drops":{"vio":0,"base_late":0,"solutions":2})",
+        "\"correction_age_s\":0.200", "\"queues\":{", R"("drops":{"vio":0,"base_late":0,"malformed":4,"solutions":2})",
         "\"pruned\":[\"G05\"]", "\"alignment\":{\"rmse_m\":0.0200", "\"lever_arm_m\":[0.0000,0.0000,0.0000]"}) {
     EXPECT_NE(j.find(key), std::string::npos) << key << " not in " << j;
   }

@@ -14,7 +14,7 @@
 //    "base_to_solution": {same},  // base's send of the epoch's last RTCM frame -> solution received here (DDS base)
 //    "correction_age_s": latest rover - base epoch time (null: no base),
 //    "queues": {"ingest>time_bridge"|...: depth}, "queue_full_waits": {same: count},
-//    "drops": {"vio": count, "base_late": count, "solutions": lost solutions},
+//    "drops": {"vio": count, "base_late": count, "malformed": DDS samples refused, "solutions": lost solutions},
 //    "solution": {"seq","status","lat_deg","lon_deg","height_m","n_sats","pruned":["G05",...],"ratio"} or null,
 //    "alignment": {"rmse_m","eigen_ratio","lever_arm_m":[x,y,z]} or null}
 // Percentiles are over the last `window` samples (nearest rank).
@@ -46,7 +46,8 @@ struct TimingSample {
   std::array<std::uint64_t, kMonitorQueues> queue_full_waits{};
   std::uint64_t vio_dropped = 0;
   std::uint64_t base_late = 0;
-  double alignment_rmse_m = 0.0;  ///< NaN: not aligned
+  std::uint64_t malformed_samples = 0;  ///< DDS samples the rover refused as malformed
+  double alignment_rmse_m = 0.0;        ///< NaN: not aligned
   double alignment_eigen_ratio = 0.0;
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };

@@ -25,7 +25,8 @@ struct EpochContext {
   std::array<std::uint64_t, app::kNumStages - 1> queue_full_waits{};
   std::uint64_t vio_dropped = 0;
   std::uint64_t base_late = 0;
-  double alignment_rmse_m = 0.0;  ///< NaN: not aligned
+  std::uint64_t malformed_samples = 0;  ///< DDS samples refused as malformed (GuardedPubSubType)
+  double alignment_rmse_m = 0.0;        ///< NaN: not aligned
   double alignment_eigen_ratio = 0.0;
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
