@@ -13,16 +13,35 @@
 namespace canyon::app {
 namespace {
 
-void copy_filter(const rtk::RtkEpoch& epoch, EpochOutput& out) {
-  out.has_float = epoch.num_dd_measurements > 0;
-  out.float_p_E_m = epoch.float_p_E_m;
-  out.float_P_E_m2 = epoch.float_P_E_m2;
-  out.dd_phase_rows = epoch.num_dd_measurements;
-  out.dd_code_rows = epoch.num_dd_code_measurements;
-  out.max_post_fit_normalised = epoch.max_post_fit_normalised;
-  out.has_prior = epoch.aided;
-  out.prior_p_E_m = epoch.prior_p_E_m;
-  out.prior_P_E_m2 = epoch.prior_P_E_m2;
+/// The output fields both engines' epochs have (rtk::RtkEpoch, fusion::FusionEpoch), with the RTK filter's figures
+/// from `filter` (rtk mode: the epoch itself; fusion: its RTK engine's epoch, FusionEpoch::rtk).
+template <typename Epoch>
+EpochOutput output_of(Epoch& epoch, const rtk::RtkEpoch& filter) {
+  EpochOutput out;
+  out.has_float = filter.num_dd_measurements > 0;
+  out.float_p_E_m = filter.float_p_E_m;
+  out.float_P_E_m2 = filter.float_P_E_m2;
+  out.dd_phase_rows = filter.num_dd_measurements;
+  out.dd_code_rows = filter.num_dd_code_measurements;
+  out.max_post_fit_normalised = filter.max_post_fit_normalised;
+  out.has_prior = filter.aided;
+  out.prior_p_E_m = filter.prior_p_E_m;
+  out.prior_P_E_m2 = filter.prior_P_E_m2;
+  out.solution = epoch.solution;
+  out.hdop = epoch.hdop;
+  out.note = std::move(epoch.note);
+  out.rejected = std::move(epoch.rejected);
+  out.ar_pruned = std::move(epoch.ar_pruned);
+  return out;
+}
+
+/// The prediction stage's verdict (either engine's predict()) into the epoch.
+void record_prediction(EpochItem& item, const Result<bool>& more) {
+  if (more) {
+    item.to_update = *more;
+  } else {
+    item.error = more.error();
+  }
 }
 
 }  // namespace
@@ -51,12 +70,7 @@ void RtkEstimator::bridge(EpochItem& item) const {
 
 void RtkEstimator::predict(EpochItem& item) {
   const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
-  auto more = engine_.predict(item.rover, base, nullptr, item.geometry ? &*item.geometry : nullptr);
-  if (!more) {
-    item.error = more.error();
-    return;
-  }
-  item.to_update = *more;
+  record_prediction(item, engine_.predict(item.rover, base, nullptr, item.geometry ? &*item.geometry : nullptr));
 }
 
 void RtkEstimator::update(EpochItem& item) {
@@ -67,14 +81,7 @@ void RtkEstimator::resolve(EpochItem& item) {
   if (item.error) return;
   if (item.to_resolve) engine_.resolve();
   rtk::RtkEpoch epoch = engine_.take_epoch();
-  EpochOutput out;
-  copy_filter(epoch, out);
-  out.solution = epoch.solution;
-  out.hdop = epoch.hdop;
-  out.note = std::move(epoch.note);
-  out.rejected = std::move(epoch.rejected);
-  out.ar_pruned = std::move(epoch.ar_pruned);
-  item.output = std::move(out);
+  item.output = output_of(epoch, epoch);
 }
 
 void FusionEstimator::bridge(EpochItem& item) const {
@@ -87,12 +94,7 @@ void FusionEstimator::align(EpochItem& item) {
 
 void FusionEstimator::predict(EpochItem& item) {
   const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
-  auto more = engine_.predict(item.rover, base, item.pose);
-  if (!more) {
-    item.error = more.error();
-    return;
-  }
-  item.to_update = *more;
+  record_prediction(item, engine_.predict(item.rover, base, item.pose));
 }
 
 void FusionEstimator::update(EpochItem& item) {
@@ -103,13 +105,7 @@ void FusionEstimator::resolve(EpochItem& item) {
   if (item.error) return;
   if (item.to_resolve) engine_.resolve();
   fusion::FusionEpoch epoch = engine_.finish_epoch();
-  EpochOutput out;
-  copy_filter(epoch.rtk, out);
-  out.solution = epoch.solution;
-  out.hdop = epoch.hdop;
-  out.note = std::move(epoch.note);
-  out.rejected = std::move(epoch.rejected);
-  out.ar_pruned = std::move(epoch.ar_pruned);
+  EpochOutput out = output_of(epoch, epoch.rtk);
   out.aided = epoch.aided;
   if (!engine_.stats().alignments.empty()) {
     const fusion::AlignmentEvent& a = engine_.stats().alignments.back();

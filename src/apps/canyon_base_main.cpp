@@ -17,6 +17,8 @@
 #include "canyon/pipeline/dds.hpp"
 #include "canyon/pipeline/rtcm_frame.hpp"
 
+#include "main_guard.hpp"
+
 namespace {
 
 constexpr int kExitRuntime = 1;
@@ -149,10 +151,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "canyon-base: internal error: " << e.what() << "\n";
-    return kExitRuntime;
-  }
+  return canyon::apps::guarded_main("canyon-base", kExitRuntime, run, argc, argv);
 }

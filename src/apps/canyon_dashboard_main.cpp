@@ -19,6 +19,8 @@
 
 #include "canyon/dashboard/dashboard.hpp"
 
+#include "main_guard.hpp"
+
 namespace {
 
 constexpr int kExitRuntime = 1;
@@ -124,10 +126,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "canyon-dashboard: internal error: " << e.what() << "\n";
-    return kExitRuntime;
-  }
+  return canyon::apps::guarded_main("canyon-dashboard", kExitRuntime, run, argc, argv);
 }

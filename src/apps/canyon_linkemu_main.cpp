@@ -32,6 +32,8 @@
 
 #include "canyon/netemu/link_model.hpp"
 
+#include "main_guard.hpp"
+
 namespace {
 
 constexpr int kExitRuntime = 1;
@@ -313,10 +315,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "canyon-linkemu: internal error: " << e.what() << "\n";
-    return kExitRuntime;
-  }
+  return canyon::apps::guarded_main("canyon-linkemu", kExitRuntime, run, argc, argv);
 }

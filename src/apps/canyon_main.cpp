@@ -24,6 +24,8 @@
 #include "canyon/core/constants.hpp"
 #include "canyon/core/satellite.hpp"
 
+#include "main_guard.hpp"
+
 namespace {
 
 constexpr int kExitInput = 1;
@@ -611,10 +613,5 @@ int main(int argc, char** argv) {
   mallopt(M_TOP_PAD, 16 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
   // Bad input is reported through Result; an exception here is a bug or resource exhaustion: say so and fail.
-  try {
-    return run_main(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "canyon: internal error: " << e.what() << "\n";
-    return kExitInput;
-  }
+  return canyon::apps::guarded_main("canyon", kExitInput, run_main, argc, argv);
 }

@@ -28,6 +28,8 @@
 #include "canyon/pipeline/rover_msgs.hpp"
 #include "canyon/pipeline/rtcm_frame.hpp"
 
+#include "main_guard.hpp"
+
 namespace {
 
 constexpr int kExitRuntime = 1;
@@ -462,10 +464,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "canyon-rover: internal error: " << e.what() << "\n";
-    return kExitRuntime;
-  }
+  return canyon::apps::guarded_main("canyon-rover", kExitRuntime, run, argc, argv);
 }

@@ -30,6 +30,8 @@
 #include "canyon/pipeline/dds.hpp"
 #include "canyon/pipeline/rover_msgs.hpp"
 #include "canyon/pipeline/rtcm_frame.hpp"
+
+#include "main_guard.hpp"
 #ifdef CANYON_WITH_DASHBOARD
 #include "canyon/dashboard/dashboard.hpp"
 #endif
@@ -396,10 +398,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "canyon-" << kTool << ": internal error: " << e.what() << "\n";
-    return kExitRuntime;
-  }
+  return canyon::apps::guarded_main("canyon-" + kTool, kExitRuntime, run, argc, argv);
 }

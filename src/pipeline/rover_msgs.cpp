@@ -54,6 +54,20 @@ msg::StageStamps to_msg_stamps(const app::EpochItem& item) {
   return s;
 }
 
+namespace {
+
+/// A message about `item`'s epoch with its sequence number and the rover epoch's GPST set.
+template <typename Msg>
+Msg epoch_message(const app::EpochItem& item) {
+  Msg m;
+  m.sequence_number(item.seq);
+  m.gps_week(item.rover.time.week);
+  m.gps_tow_s(item.rover.time.tow_s);
+  return m;
+}
+
+}  // namespace
+
 msg::Solution to_msg_solution(const app::EpochItem& item, const EpochContext& context) {
   msg::Solution m;
   m.sequence_number(item.seq);
@@ -89,11 +103,8 @@ msg::Solution to_msg_solution(const app::EpochItem& item, const EpochContext& co
 }
 
 msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& context) {
-  msg::StageTiming m;
-  m.sequence_number(item.seq);
+  auto m = epoch_message<msg::StageTiming>(item);
   m.rover_id(context.rover_id);
-  m.gps_week(item.rover.time.week);
-  m.gps_tow_s(item.rover.time.tow_s);
   m.stamps(to_msg_stamps(item));
   m.correction_age_s(item.base ? item.rover.time - item.base->time : std::numeric_limits<double>::quiet_NaN());
   std::array<std::uint32_t, 5> depth{};
@@ -115,10 +126,7 @@ msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& c
 }
 
 msg::BridgedEpoch to_msg_bridged(const app::EpochItem& item) {
-  msg::BridgedEpoch m;
-  m.sequence_number(item.seq);
-  m.gps_week(item.rover.time.week);
-  m.gps_tow_s(item.rover.time.tow_s);
+  auto m = epoch_message<msg::BridgedEpoch>(item);
   m.valid(item.pose.has_value());
   if (item.pose) {
     m.vio_segment(item.pose->segment);
@@ -132,10 +140,7 @@ msg::BridgedEpoch to_msg_bridged(const app::EpochItem& item) {
 }
 
 msg::Prior to_msg_prior(const app::EpochItem& item) {
-  msg::Prior m;
-  m.sequence_number(item.seq);
-  m.gps_week(item.rover.time.week);
-  m.gps_tow_s(item.rover.time.tow_s);
+  auto m = epoch_message<msg::Prior>(item);
   if (item.output && item.output->has_prior) {
     const app::EpochOutput& o = *item.output;
     m.aided(true);
@@ -147,10 +152,7 @@ msg::Prior to_msg_prior(const app::EpochItem& item) {
 }
 
 msg::FloatSolution to_msg_float(const app::EpochItem& item) {
-  msg::FloatSolution m;
-  m.sequence_number(item.seq);
-  m.gps_week(item.rover.time.week);
-  m.gps_tow_s(item.rover.time.tow_s);
+  auto m = epoch_message<msg::FloatSolution>(item);
   if (item.output && item.output->has_float) {
     const app::EpochOutput& o = *item.output;
     m.valid(true);
@@ -166,10 +168,7 @@ msg::FloatSolution to_msg_float(const app::EpochItem& item) {
 }
 
 msg::Alignment to_msg_alignment(const app::EpochItem& item) {
-  msg::Alignment m;
-  m.sequence_number(item.seq);
-  m.gps_week(item.rover.time.week);
-  m.gps_tow_s(item.rover.time.tow_s);
+  auto m = epoch_message<msg::Alignment>(item);
   m.kind("none");
   if (item.output && item.output->alignment) {
     const app::EpochOutput::Alignment& a = *item.output->alignment;
