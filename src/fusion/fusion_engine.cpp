@@ -82,6 +82,7 @@ std::string FusionOptions::validate() const {
     return "max_prior_rejections must be >= 0, gate_conflict_epochs >= 1 and reanchor_sigma_m > 0";
   }
   if (!(max_fix_sigma_m > 0.0)) return "max_fix_sigma_m must be > 0";
+  if (!(vio_keep_s > 0.0)) return "vio_keep_s must be > 0";
   if (!(max_post_fit_normalised > 0.0) || !(max_prior_chi2 > 0.0) || !(false_fix_chi2 > 0.0)) {
     return "max_post_fit_normalised, max_prior_chi2 and false_fix_chi2 must be > 0";
   }
@@ -106,6 +107,7 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
   const Eigen::Vector3d p_state = engine_.position_E_m();
   if (options_.prediction == Prediction::Vio) {
     if (!alignment_ || !pose) return std::nullopt;
+    const std::shared_lock lock(track_mutex_);
     const auto before = track_.pose_at(t_state);
     if (!before || before->segment != pose->segment || pose->segment != alignment_->segment) return std::nullopt;
     const Eigen::Vector3d up_E =
@@ -187,11 +189,27 @@ Result<FusionEpoch> FusionEngine::process(const core::ObsEpoch& rover, const cor
 }
 
 std::optional<VioPoseAt> FusionEngine::bridge(const core::GpsTime& t) const {
+  const std::shared_lock lock(track_mutex_);
   return track_.pose_at(t);
+}
+
+bool FusionEngine::add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note) {
+  const std::unique_lock lock(track_mutex_);
+  return track_.append(record, t, note);
+}
+
+bool FusionEngine::vio_covers(const core::GpsTime& t) const {
+  const std::shared_lock lock(track_mutex_);
+  return track_.covers(t);
 }
 
 void FusionEngine::align(const core::GpsTime& t, const std::optional<VioPoseAt>& pose) {
   flush_alignment();
+  {
+    // Epochs still in the pipeline are later than t; the prediction reaches back to the last epoch only.
+    const std::unique_lock lock(track_mutex_);
+    track_.forget_before(t - options_.vio_keep_s);
+  }
   ++stats_.epochs;
   if (!pose) ++stats_.no_vio;
   if (pose && last_segment_ && *last_segment_ != pose->segment) {

@@ -28,6 +28,8 @@ std::string TimeBridgeOptions::validate() const {
   if (!(min_outlier_threshold_s >= 0.0)) return "min_outlier_threshold_s must be >= 0";
   if (!(max_residual_rms_s > 0.0)) return "max_residual_rms_s must be > 0";
   if (!(max_drift_ppm > 0.0)) return "max_drift_ppm must be > 0";
+  if (!(causal_hold_s >= 0.0)) return "causal_hold_s must be >= 0";
+  if (causal_window_pairs < 1) return "causal_window_pairs must be >= 1";
   return {};
 }
 
@@ -141,6 +143,64 @@ Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& input
                  " ppm is beyond the " + std::to_string(options.max_drift_ppm) + " ppm allowed"};
   }
   return fit;
+}
+
+CausalTimeBridge CausalTimeBridge::gps_clock() {
+  CausalTimeBridge b{TimeBridgeOptions{}};
+  b.gps_clock_ = true;
+  return b;
+}
+
+Status CausalTimeBridge::add(const io::TimeSyncPair& pair) {
+  if (!pairs_.empty() && !(pair.t_ns > pairs_.back().t_ns)) {
+    return Error{"time-sync pair at device time " + std::to_string(pair.t_ns) + " ns is not after the previous one (" +
+                 std::to_string(pairs_.back().t_ns) + " ns): ignored"};
+  }
+  pairs_.push_back(pair);
+  ++received_;
+  return Ok{};
+}
+
+bool CausalTimeBridge::ready(std::int64_t t_ns) const {
+  if (gps_clock_) return true;
+  const auto hold_ns = static_cast<std::int64_t>(std::llround(options_.causal_hold_s * 1e9));
+  return !pairs_.empty() && pairs_.back().t_ns > t_ns - hold_ns;
+}
+
+Result<core::GpsTime> CausalTimeBridge::to_gps(std::int64_t t_ns) {
+  if (gps_clock_) return TimeBridge::gps_clock().to_gps(t_ns);
+  const auto hold_ns = static_cast<std::int64_t>(std::llround(options_.causal_hold_s * 1e9));
+  const std::int64_t cutoff_ns = t_ns - hold_ns;
+  // The pairs at or before the cutoff: [0, end) of pairs_; the fit takes the last window of them.
+  const auto end =
+      static_cast<std::size_t>(std::upper_bound(pairs_.begin(), pairs_.end(), cutoff_ns,
+                                                [](std::int64_t t, const io::TimeSyncPair& p) { return t < p.t_ns; }) -
+                               pairs_.begin());
+  if (end == 0) {
+    return Error{"no time-sync pair " + std::to_string(options_.causal_hold_s) +
+                 " s before the VIO pose yet (device time " + std::to_string(t_ns) + " ns)"};
+  }
+  const std::size_t window = static_cast<std::size_t>(options_.causal_window_pairs);
+  const std::size_t begin = end > window ? end - window : 0;
+  // Queries come in increasing t_ns: pairs before the window are never used again.
+  pairs_.erase(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(begin));
+  dropped_ += begin;
+  const std::uint64_t first = dropped_;
+  const std::uint64_t last = dropped_ + (end - begin) - 1;
+  if (!(fit_ || fit_error_) || first != fit_first_ || last != fit_last_) {
+    const std::vector<io::TimeSyncPair> used(pairs_.begin(), pairs_.begin() + static_cast<std::ptrdiff_t>(end - begin));
+    auto fit = fit_time_bridge(used, options_);
+    fit_first_ = first;
+    fit_last_ = last;
+    if (fit) {
+      fit_ = std::move(*fit);
+      fit_error_.reset();
+    } else {
+      fit_error_ = fit.error();
+    }
+  }
+  if (fit_error_) return *fit_error_;
+  return fit_->bridge.to_gps(t_ns);
 }
 
 }  // namespace canyon::fusion

@@ -34,44 +34,58 @@ std::string VioTrackOptions::validate() const {
   return {};
 }
 
+std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options) {
+  const double dt_s = s.t_s - prev.t_s;
+  const double jump_m = (s.T_OI.p - prev.T_OI.p).norm();
+  const double turn_deg = core::so3_log(prev.T_OI.q.conjugate() * s.T_OI.q).norm() * core::kRadToDeg;
+  const double trace = s.P.topLeftCorner<3, 3>().trace();
+  const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
+  char buffer[160];
+  if (dt_s > options.max_gap_s) {
+    std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s", dt_s);
+    return buffer;
+  }
+  if (jump_m > options.max_speed_mps * dt_s || turn_deg > options.max_rotation_rate_dps * dt_s) {
+    std::snprintf(buffer, sizeof buffer, "VIO jump of %.2f m and %.1f deg in %.3f s (odometry frame reset)", jump_m,
+                  turn_deg, dt_s);
+    return buffer;
+  }
+  if (prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace) {
+    std::snprintf(buffer, sizeof buffer, "VIO covariance reset (position trace %.3g -> %.3g m^2)", prev_trace, trace);
+    return buffer;
+  }
+  return {};
+}
+
+namespace {
+
+/// Gives `s` its segment after `prev` (nullptr: the first sample); the reason and the new segment in `note`.
+void place_in_segment(const VioTrackSample* prev, VioTrackSample& s, const VioTrackOptions& options,
+                      const core::GpsTime& reference, std::string* note) {
+  if (prev == nullptr) {
+    s.segment = 0;
+    s.C_previous.setZero();
+    return;
+  }
+  const std::string why = segment_break(*prev, s, options);
+  s.segment = prev->segment;
+  if (why.empty()) return;
+  s.segment = prev->segment + 1;
+  s.C_previous.setZero();  // no predecessor in its segment
+  if (note != nullptr) {
+    *note = why + " at " + when(reference + s.t_s) + " (line " + std::to_string(s.line) + "): new VIO segment " +
+            std::to_string(s.segment) + ", fusion re-aligns";
+  }
+}
+
+}  // namespace
+
 void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
                      const core::GpsTime& reference, std::vector<std::string>* notes) {
-  int segment = 0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
-    VioTrackSample& s = samples[k];
-    bool new_segment = k == 0;
-    if (k > 0) {
-      const VioTrackSample& prev = samples[k - 1];
-      const double dt_s = s.t_s - prev.t_s;
-      const double jump_m = (s.T_OI.p - prev.T_OI.p).norm();
-      const double turn_deg = core::so3_log(prev.T_OI.q.conjugate() * s.T_OI.q).norm() * core::kRadToDeg;
-      const double trace = s.P.topLeftCorner<3, 3>().trace();
-      const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
-      std::string why;
-      char buffer[160];
-      if (dt_s > options.max_gap_s) {
-        std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s", dt_s);
-        why = buffer;
-      } else if (jump_m > options.max_speed_mps * dt_s || turn_deg > options.max_rotation_rate_dps * dt_s) {
-        std::snprintf(buffer, sizeof buffer, "VIO jump of %.2f m and %.1f deg in %.3f s (odometry frame reset)", jump_m,
-                      turn_deg, dt_s);
-        why = buffer;
-      } else if (prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace) {
-        std::snprintf(buffer, sizeof buffer, "VIO covariance reset (position trace %.3g -> %.3g m^2)", prev_trace,
-                      trace);
-        why = buffer;
-      }
-      if (!why.empty()) {
-        ++segment;
-        new_segment = true;
-        if (notes != nullptr) {
-          notes->push_back(why + " at " + when(reference + s.t_s) + " (line " + std::to_string(s.line) +
-                           "): new VIO segment " + std::to_string(segment) + ", fusion re-aligns");
-        }
-      }
-    }
-    s.segment = segment;
-    if (new_segment) s.C_previous.setZero();  // no predecessor in its segment
+    std::string note;
+    place_in_segment(k == 0 ? nullptr : &samples[k - 1], samples[k], options, reference, &note);
+    if (notes != nullptr && !note.empty()) notes->push_back(note);
   }
 }
 
@@ -100,6 +114,45 @@ VioTrack VioTrack::from_samples(std::vector<VioTrackSample> samples, core::GpsTi
                                 const VioTrackOptions& options) {
   assign_segments(samples, options, reference, nullptr);
   return VioTrack(std::move(samples), reference, options);
+}
+
+VioTrack VioTrack::streaming(const VioTrackOptions& options) {
+  return VioTrack({}, core::GpsTime{}, options);
+}
+
+bool VioTrack::append(const io::VioRecord& record, const core::GpsTime& t, std::string* note) {
+  if (samples_.empty() && forgotten_ == 0) reference_ = t;
+  VioTrackSample s;
+  s.t_s = t - reference_;
+  if (!samples_.empty() && !(s.t_s > samples_.back().t_s)) return false;
+  s.T_OI = record.T_OI;
+  s.P = record.covariance;
+  if (options_.use_cross_covariance && record.cross_previous) s.C_previous = *record.cross_previous;
+  s.line = record.line;
+  place_in_segment(samples_.empty() ? nullptr : &samples_.back(), s, options_, reference_, note);
+  samples_.push_back(s);
+  return true;
+}
+
+void VioTrack::forget_before(const core::GpsTime& t) {
+  const double t_s = t - reference_;
+  // Keep the last sample before t (an interpolation at t may need it).
+  const auto it = std::lower_bound(samples_.begin(), samples_.end(), t_s,
+                                   [](const VioTrackSample& s, double value) { return s.t_s < value; });
+  const auto drop = static_cast<std::size_t>(std::max<std::ptrdiff_t>(it - samples_.begin() - 1, 0));
+  // Erase in batches (a quarter of the track at least) so that appending stays amortised O(1).
+  if (drop == 0 || drop < samples_.size() / 4) return;
+  samples_.erase(samples_.begin(), samples_.begin() + static_cast<std::ptrdiff_t>(drop));
+  forgotten_ += static_cast<int>(drop);
+}
+
+bool VioTrack::covers(const core::GpsTime& t) const {
+  const double t_s = t - reference_;
+  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t_s,
+                                   [](double value, const VioTrackSample& s) { return value < s.t_s; });
+  if (it == samples_.end()) return false;
+  const bool starts_segment = it == samples_.begin() ? forgotten_ == 0 : (it - 1)->segment != it->segment;
+  return !starts_segment || it + 1 != samples_.end();
 }
 
 std::optional<VioPoseAt> VioTrack::pose_at(const core::GpsTime& t) const {
@@ -133,7 +186,7 @@ std::optional<VioPoseAt> VioTrack::pose_at(const core::GpsTime& t) const {
   const VioTrackSample& s1 = samples_[static_cast<std::size_t>(upper)];
   VioPoseAt p;
   p.t_s = t_s;
-  p.lower = lower;
+  p.lower = lower + forgotten_;  // counting the forgotten samples
   p.segment = s0.segment;
   p.a = (t_s - s0.t_s) / (s1.t_s - s0.t_s);
   p.T_OI = core::se3_interpolate(s0.T_OI, s1.T_OI, p.a, &p.J_lower, &p.J_upper);
@@ -141,14 +194,13 @@ std::optional<VioPoseAt> VioTrack::pose_at(const core::GpsTime& t) const {
 }
 
 core::Matrix6d VioTrack::sample_covariance(int k, int l) const {
-  if (k == l) return samples_[static_cast<std::size_t>(k)].P;
+  if (k == l) return sample(k).P;
   if (k > l) return sample_covariance(l, k).transpose();
-  if (l == k + 1) return samples_[static_cast<std::size_t>(l)].C_previous;
+  if (l == k + 1) return sample(l).C_previous;
   // Propagate the earlier error through the relative motion D_l = T_l-1^-1 T_l: Sigma_kl = Sigma_k,l-1 Ad(D_l^-1)^T.
-  core::Matrix6d sigma = samples_[static_cast<std::size_t>(k) + 1].C_previous;
+  core::Matrix6d sigma = sample(k + 1).C_previous;
   for (int m = k + 2; m <= l; ++m) {
-    const core::Pose D =
-        samples_[static_cast<std::size_t>(m - 1)].T_OI.inverse() * samples_[static_cast<std::size_t>(m)].T_OI;
+    const core::Pose D = sample(m - 1).T_OI.inverse() * sample(m).T_OI;
     sigma = sigma * core::se3_adjoint(D.inverse()).transpose();
   }
   return sigma;

@@ -120,6 +120,102 @@ TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   EXPECT_FALSE(track.pose_at(ref + 100.0).has_value());  // after the last
 }
 
+TEST(CausalTimeBridgeTest, MapsWithThePairsOlderThanTheHoldOnlyAndOnlyOnceTheyAreIn) {
+  // Pairs at 1 Hz of a device clock 50 ppm fast with 0.1 ms jitter; hold 1.5 s, window 5 pairs.
+  const core::GpsTime start{2266, 316800.0};
+  const auto device_ns = [](double t_s) { return std::llround((100.0 + t_s * (1.0 + 50e-6)) * 1e9); };
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> jitter(0.0, 1e-4);
+  std::vector<io::TimeSyncPair> pairs;
+  pairs.reserve(20);
+  for (int k = 0; k < 20; ++k) {
+    pairs.push_back(io::TimeSyncPair{device_ns(k) + std::llround(jitter(rng) * 1e9), start + k, k + 2});
+  }
+  TimeBridgeOptions options;
+  options.causal_hold_s = 1.5;
+  options.causal_window_pairs = 5;
+  CausalTimeBridge bridge(options);
+  const std::int64_t t_early = device_ns(1.2);
+  EXPECT_FALSE(bridge.ready(t_early));
+  ASSERT_TRUE(bridge.add(pairs[0]).ok());
+  EXPECT_TRUE(bridge.ready(t_early));         // a pair later than t - 1.5 s is in
+  EXPECT_FALSE(bridge.to_gps(t_early).ok());  // but none at least 1.5 s older: not mappable
+  for (int k = 1; k < 20; ++k) ASSERT_TRUE(bridge.add(pairs[static_cast<std::size_t>(k)]).ok());
+  EXPECT_FALSE(bridge.add(pairs[5]).ok());  // not after the last one: refused
+  // Each time uses the fit to the last 5 pairs at least 1.5 s older, nothing else.
+  for (int i = 0; i < 46; ++i) {
+    const double t_s = 2.0 + 0.37 * i;
+    const std::int64_t t_ns = device_ns(t_s);
+    std::vector<io::TimeSyncPair> used;
+    for (const io::TimeSyncPair& p : pairs) {
+      if (p.t_ns <= t_ns - 1'500'000'000) used.push_back(p);
+    }
+    if (used.size() > 5) used.erase(used.begin(), used.end() - 5);
+    auto expected = fit_time_bridge(used, options);
+    ASSERT_TRUE(expected.ok()) << expected.error().to_string() << " at " << t_s << " with " << used.size();
+    auto got = bridge.to_gps(t_ns);
+    ASSERT_TRUE(got.ok()) << got.error().to_string();
+    EXPECT_EQ(*got - expected->bridge.to_gps(t_ns), 0.0) << t_s;
+    EXPECT_LT(std::abs(*got - (start + t_s)), 3e-3) << t_s;
+  }
+  CausalTimeBridge gps = CausalTimeBridge::gps_clock();
+  EXPECT_TRUE(gps.ready(0));
+  EXPECT_EQ(gps.to_gps(std::int64_t{2266} * 604800 * 1000000000)->week, 2266);
+}
+
+TEST(VioTrackTest, AppendedPoseByPoseEqualsTheWholeTrackAndForgettingKeepsIndicesValid) {
+  std::vector<VioTrackSample> s = straight_samples(60, 0.1, 1.4);
+  for (int k = 25; k < 60; ++k) s[static_cast<std::size_t>(k)].t_s += 1.0;           // a gap before sample 25
+  for (int k = 40; k < 60; ++k) s[static_cast<std::size_t>(k)].T_OI.p.x() += 100.0;  // a jump at sample 40
+  for (int k = 1; k < 60; ++k) s[static_cast<std::size_t>(k)].C_previous = core::Matrix6d::Identity() * 1e-5;
+  const core::GpsTime ref{2266, 100.0};
+  const VioTrack whole = VioTrack::from_samples(s, ref);
+  VioTrack live = VioTrack::streaming({});
+  std::vector<std::string> notes;
+  for (const VioTrackSample& v : s) {
+    io::VioRecord r;
+    r.T_OI = v.T_OI;
+    r.covariance = v.P;
+    r.cross_previous = v.C_previous;
+    r.line = v.line;
+    std::string note;
+    ASSERT_TRUE(live.append(r, ref + v.t_s, &note));
+    if (!note.empty()) notes.push_back(note);
+  }
+  io::VioRecord again;
+  EXPECT_FALSE(live.append(again, ref + s.back().t_s));  // not after the last pose
+  EXPECT_EQ(live.segments(), whole.segments());
+  EXPECT_EQ(notes.size(), 2U);
+  std::optional<VioPoseAt> previous;
+  for (int i = 0; i < 110; ++i) {
+    const double t_s = -0.04 + 0.0731 * i;
+    const auto a = whole.pose_at(ref + t_s);
+    const auto b = live.pose_at(ref + t_s);
+    ASSERT_EQ(a.has_value(), b.has_value()) << t_s;
+    if (!a) continue;
+    EXPECT_EQ(a->lower, b->lower);
+    EXPECT_LT((a->T_OI.p - b->T_OI.p).norm(), 1e-12);
+    if (previous && previous->segment == a->segment) {
+      EXPECT_LT((whole.joint_covariance(*previous, *a) - live.joint_covariance(*previous, *b)).norm(), 1e-12);
+    }
+    previous = a;
+  }
+  // covers(t): a later pose exists (and, when it starts a segment, the one after it).
+  EXPECT_TRUE(live.covers(ref + 1.0));
+  EXPECT_FALSE(live.covers(ref + s.back().t_s));
+  // Forgetting the samples before 4 s keeps the indices of what is left.
+  const auto before = live.pose_at(ref + 4.55);
+  ASSERT_TRUE(before.has_value());
+  live.forget_before(ref + 4.0);
+  const auto after = live.pose_at(ref + 4.55);
+  ASSERT_TRUE(after.has_value());
+  EXPECT_EQ(before->lower, after->lower);
+  const auto later = live.pose_at(ref + 4.95);
+  ASSERT_TRUE(later.has_value());
+  EXPECT_LT((live.joint_covariance(*after, *later) - whole.joint_covariance(*after, *later)).norm(), 1e-12);
+  EXPECT_FALSE(live.pose_at(ref + 1.0).has_value());  // forgotten
+}
+
 /// The increment of the antenna between two interpolated times, from VIO runs of many seeds along one walk: its
 /// error against the true increment is consistent with the covariance of Eqs. 4-5 (mean NEES of 3).
 TEST(VioPredictionTest, IncrementCovarianceMatchesTheSimulatedVioErrorsOverSeeds) {

@@ -36,7 +36,9 @@
 // solutions (none if they are more than 5 s apart or imply more than vio_max_speed_mps), with covariance
 // (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
 
+#include <mutex>
 #include <optional>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -95,6 +97,7 @@ struct FusionOptions {
   int gate_conflict_epochs = 5;          ///< after this many consecutive epochs in which the gates rejected more DD
                                          ///< rows than the update used, the prior is widened by reanchor_sigma_m
   double reanchor_sigma_m = 2.0;         ///< (m, per axis)
+  double vio_keep_s = 120.0;             ///< VIO samples older than this before the epoch are forgotten (s)
 
   [[nodiscard]] std::string validate() const;
 };
@@ -176,6 +179,14 @@ class FusionEngine {
   FusionEpoch finish_epoch();
   /// Runs an alignment left pending by the last epoch (end of the input).
   void flush_alignment();
+
+  // A live VIO stream (app::LiveVio): poses appended while the stages run. The track is guarded by a reader-writer
+  // lock: appends (the time bridge's thread) exclude the readers (bridge(), the prediction); forgetting happens in
+  // align().
+  /// Appends a pose at GPST t to the track (VioTrack::append); false if not after the last one.
+  bool add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr);
+  /// The track has the poses that make bridge(t) final (VioTrack::covers).
+  [[nodiscard]] bool vio_covers(const core::GpsTime& t) const;
   /// The lever arm t_IA in use (the prior until calibrated) (m, IMU frame).
   [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return t_IA_m_; }
 
@@ -223,6 +234,7 @@ class FusionEngine {
   Cn0Screen cn0_screen_;
   rtk::RtkEngine engine_;
   VioTrack track_;
+  mutable std::shared_mutex track_mutex_;  // see add_vio()
   std::optional<Alignment> alignment_;
   Eigen::Vector3d t_IA_m_;
   bool calibrated_ = false;

@@ -13,8 +13,18 @@
 // Reported: a, b (as the drift in ppm), the inliers' residual RMS and largest residual, and the rejected pairs.
 // One pair determines the offset only: b = 1 (drift taken as zero), with a warning. VIO already on GPST (t_ns =
 // GPST nanoseconds since 1980-01-06 00:00:00) needs no pairs: TimeBridge::gps_clock().
+//
+// Whole file or causal. `canyon process` may fit all pairs of the file at once (whole_file). A live rover cannot:
+// it maps each VIO pose with what it has received. CausalTimeBridge makes that deterministic: a pose at device time
+// t_ns is mapped with the fit to the pairs whose device time is at most t_ns - hold (the last window_pairs of them),
+// and only once a pair later than t_ns - hold has been seen (pairs arrive in device-time order, so none of the pairs
+// it uses can still be on its way). With pairs every second and hold 1.5 s a pose waits for nothing in steady state,
+// the fit is extrapolated by at most hold + 1 s, and files and DDS streams give the same mapping (canyon process with
+// timesync_mode: causal equals the rover fed over DDS).
 
 #include <cstdint>
+#include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +39,9 @@ struct TimeBridgeOptions {
   double min_outlier_threshold_s = 2e-3;  ///< r_min: residuals up to this are never outliers (s)
   double max_residual_rms_s = 0.02;       ///< a fit whose inliers' residual RMS is larger is refused (s)
   double max_drift_ppm = 1000.0;          ///< a fitted drift beyond this is refused (ppm)
+  bool causal = false;                    ///< false: one fit to every pair (files); true: CausalTimeBridge
+  double causal_hold_s = 1.5;             ///< causal: a pose uses the pairs at least this much older (s)
+  int causal_window_pairs = 600;          ///< causal: at most this many of the latest such pairs
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;
@@ -70,5 +83,36 @@ struct TimeBridgeFit {
 /// inliers' residual RMS or the drift is beyond the options' limits, or if fewer than half the pairs are inliers.
 Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& pairs,
                                       const TimeBridgeOptions& options = {});
+
+/// Device clock -> GPST for streams (see the top of this file): pairs and poses in device-time order each.
+class CausalTimeBridge {
+ public:
+  explicit CausalTimeBridge(TimeBridgeOptions options) : options_(options) {}
+  /// For VIO stamped with GPST nanoseconds: no pair needed, always ready.
+  static CausalTimeBridge gps_clock();
+  /// A pair received. Error (the pair is ignored) when it is not later than the previous one.
+  Status add(const io::TimeSyncPair& pair);
+  /// Every pair the mapping of t_ns uses has been received: a pair later than t_ns - hold has been seen.
+  [[nodiscard]] bool ready(std::int64_t t_ns) const;
+  /// GPST of device time t_ns (queries in increasing t_ns; older pairs are forgotten), or an error: no pair old
+  /// enough yet, or the fit refused (fit_time_bridge's reasons).
+  Result<core::GpsTime> to_gps(std::int64_t t_ns);
+  /// Pairs received so far.
+  [[nodiscard]] std::uint64_t pairs_received() const { return received_; }
+  /// The fit in use (nullopt before the first).
+  [[nodiscard]] const std::optional<TimeBridgeFit>& fit() const { return fit_; }
+
+ private:
+  TimeBridgeOptions options_;
+  bool gps_clock_ = false;
+  std::deque<io::TimeSyncPair> pairs_;
+  std::uint64_t received_ = 0;
+  std::uint64_t dropped_ = 0;  // forgotten from the front of pairs_ (index of pairs_[0] among all received)
+  // The fit in use and the pairs it was made from (indices among all received, [first, last]).
+  std::optional<TimeBridgeFit> fit_;
+  std::uint64_t fit_first_ = 0;
+  std::uint64_t fit_last_ = 0;
+  std::optional<Error> fit_error_;
+};
 
 }  // namespace canyon::fusion

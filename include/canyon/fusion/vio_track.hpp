@@ -19,6 +19,11 @@
 // on the increments, as canyon's simulator and filter-based VIO):
 //   Sigma_k,l = Sigma_k,l-1 A_l^T,  A_l = Ad(D_l^-1),  D_l = T_l-1^-1 T_l   (l > k + 1).
 // Then cov([xi(t_a); xi(t_b)]) = J Sigma J^T with J the interpolation Jacobians (12 x 6 |samples|).
+//
+// Streaming (the live rover): poses are appended one by one (append(), segments assigned as they come, exactly as
+// build() does) and the oldest forgotten (forget_before()); sample indices (VioPoseAt::lower) count every sample
+// ever appended, so a pose interpolated before a forget stays valid as long as its samples are kept. covers(t) says
+// when a pose at t is final: what pose_at(t) returns can no longer change with later samples.
 
 #include <optional>
 #include <string>
@@ -74,6 +79,17 @@ class VioTrack {
   /// From samples directly (tests); times relative to `reference`.
   static VioTrack from_samples(std::vector<VioTrackSample> samples, core::GpsTime reference,
                                const VioTrackOptions& options = {});
+  /// An empty track that poses are appended to (the reference time is the first pose's).
+  static VioTrack streaming(const VioTrackOptions& options);
+
+  /// Appends the pose of `record` at GPST t, its segment assigned as build() would (a new segment: `note`, if
+  /// given, receives why). False, and nothing appended, when t is not after the last pose's time.
+  bool append(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr);
+  /// Forgets the samples before GPST t except the last one before it (memory of a long live run).
+  void forget_before(const core::GpsTime& t);
+  /// pose_at(t) is final: a sample after t exists, and when it starts a segment, the one after it too.
+  [[nodiscard]] bool covers(const core::GpsTime& t) const;
+  [[nodiscard]] bool empty() const { return samples_.empty(); }
 
   /// The pose at GPST t, nullopt outside every segment (beyond extrapolation_s) or in a gap.
   [[nodiscard]] std::optional<VioPoseAt> pose_at(const core::GpsTime& t) const;
@@ -91,13 +107,20 @@ class VioTrack {
  private:
   VioTrack(std::vector<VioTrackSample> samples, core::GpsTime reference, VioTrackOptions options)
       : samples_(std::move(samples)), reference_(reference), options_(options) {}
-  /// cov(xi_k, xi_l) for samples k <= l of one segment.
+  /// cov(xi_k, xi_l) for samples k <= l of one segment (indices as in VioPoseAt).
   [[nodiscard]] core::Matrix6d sample_covariance(int k, int l) const;
+  [[nodiscard]] const VioTrackSample& sample(int index) const {
+    return samples_[static_cast<std::size_t>(index - forgotten_)];
+  }
 
   std::vector<VioTrackSample> samples_;
   core::GpsTime reference_;
   VioTrackOptions options_;
+  int forgotten_ = 0;  // samples forgotten from the front: samples_[0] has index forgotten_
 };
+
+/// Why `next` starts a new segment after `previous` (a gap, a jump, a covariance reset), empty if it does not.
+std::string segment_break(const VioTrackSample& previous, const VioTrackSample& next, const VioTrackOptions& options);
 
 /// Splits samples into segments (gaps, jumps, covariance resets), appending a note for each break.
 void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
