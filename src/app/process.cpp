@@ -293,6 +293,53 @@ std::string gps_text(const core::GpsTime& t) {
   return buffer;
 }
 
+/// The VIO track with the causal time bridge (fusion.timesync_mode: causal): every pose mapped as the live rover maps
+/// it (fusion::CausalTimeBridge), so that `canyon process` reproduces a rover fed over DDS.
+Result<fusion::VioTrack> load_vio_causal(const ProcessConfig& config, const io::VioFile& vio, ProcessSummary& summary) {
+  fusion::CausalTimeBridge bridge = fusion::CausalTimeBridge::gps_clock();
+  if (!config.fusion.vio_on_gps_time) {
+    auto sync = io::read_timesync_csv(config.timesync);
+    if (!sync) return sync.error();
+    summary.warnings.insert(summary.warnings.end(), sync->warnings.begin(), sync->warnings.end());
+    bridge = fusion::CausalTimeBridge(config.fusion.time_sync);
+    for (const io::TimeSyncPair& pair : sync->pairs) {
+      if (Status s = bridge.add(pair); !s) {
+        summary.warnings.push_back(config.timesync + ":" + std::to_string(pair.line) + ": " + s.error().message);
+      }
+    }
+  }
+  fusion::VioTrack track = fusion::VioTrack::streaming(config.fusion.vio);
+  int unmapped = 0;
+  for (const io::VioRecord& record : vio.records) {
+    auto t = bridge.to_gps(record.t_ns);
+    if (!t) {
+      if (unmapped++ == 0) {
+        summary.report.push_back("fusion: " + config.vio + ":" + std::to_string(record.line) +
+                                 ": pose not mapped to GPST: " + t.error().message);
+      }
+      continue;
+    }
+    std::string note;
+    (void)track.append(record, *t, &note);  // a fit cannot reorder poses a few ms apart; if it did, dropped
+    if (!note.empty()) summary.report.push_back("fusion: " + note);
+  }
+  if (unmapped > 0) {
+    summary.report.push_back("fusion: " + std::to_string(unmapped) +
+                             " VIO poses before the causal time bridge had its pairs (not used)");
+  }
+  if (track.empty()) return Error{"no VIO pose mapped to GPST by the causal time bridge", config.vio, 0};
+  if (const std::optional<fusion::TimeBridgeFit>& fit = bridge.fit()) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "fusion: causal time bridge (pairs %.1f s older than each pose, at most %d): last fit from %d "
+                  "pairs, drift %.2f ppm, residual RMS %.3f ms",
+                  config.fusion.time_sync.causal_hold_s, config.fusion.time_sync.causal_window_pairs, fit->pairs,
+                  fit->bridge.drift_ppm(), fit->residual_rms_s * 1e3);
+    summary.report.emplace_back(line);
+  }
+  return track;
+}
+
 /// The VIO trajectory on GPST: vio.csv through the time bridge (timesync.csv, unless the VIO is on GPST), split into
 /// segments.
 Result<fusion::VioTrack> load_vio(const ProcessConfig& config, ProcessSummary& summary) {
@@ -304,6 +351,7 @@ Result<fusion::VioTrack> load_vio(const ProcessConfig& config, ProcessSummary& s
                                ": no cross-covariance columns: consecutive VIO poses taken as uncorrelated (the "
                                "increments' covariance is then the sum of the poses' covariances, pessimistic)");
   }
+  if (config.fusion.time_sync.causal) return load_vio_causal(config, *vio, summary);
   fusion::TimeBridge bridge = fusion::TimeBridge::gps_clock();
   char line[200];
   if (config.fusion.vio_on_gps_time) {

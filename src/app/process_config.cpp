@@ -147,6 +147,14 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("timesync_min_outlier_threshold_s", o.time_sync.min_outlier_threshold_s);
   map.get("timesync_max_residual_rms_s", o.time_sync.max_residual_rms_s);
   map.get("timesync_max_drift_ppm", o.time_sync.max_drift_ppm);
+  std::string mode = o.time_sync.causal ? "causal" : "whole_file";
+  map.get("timesync_mode", mode);
+  if (mode != "whole_file" && mode != "causal") {
+    map.fail("timesync_mode", "must be whole_file or causal, not '" + mode + "'");
+  }
+  o.time_sync.causal = mode == "causal";
+  map.get("timesync_hold_s", o.time_sync.causal_hold_s);
+  map.get("timesync_window_pairs", o.time_sync.causal_window_pairs);
   map.get("vio_max_gap_s", o.vio.max_gap_s);
   map.get("vio_max_speed_mps", o.vio.max_speed_mps);
   map.get("vio_max_rotation_rate_dps", o.vio.max_rotation_rate_dps);
@@ -201,6 +209,7 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("max_prior_rejections", o.max_prior_rejections);
   map.get("gate_conflict_epochs", o.gate_conflict_epochs);
   map.get("reanchor_sigma_m", o.reanchor_sigma_m);
+  map.get("vio_keep_s", o.vio_keep_s);
   map.get("cn0_screen", o.cn0.enabled);
   map.get("cn0_margin_db", o.cn0.margin_db);
   map.get("cn0_quantile", o.cn0.quantile);
@@ -404,6 +413,9 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("timesync_min_outlier_threshold_s") << o.time_sync.min_outlier_threshold_s;
   key("timesync_max_residual_rms_s") << o.time_sync.max_residual_rms_s;
   key("timesync_max_drift_ppm") << o.time_sync.max_drift_ppm;
+  key("timesync_mode") << (o.time_sync.causal ? "causal" : "whole_file");
+  key("timesync_hold_s") << o.time_sync.causal_hold_s;
+  key("timesync_window_pairs") << o.time_sync.causal_window_pairs;
   key("vio_max_gap_s") << o.vio.max_gap_s;
   key("vio_max_speed_mps") << o.vio.max_speed_mps;
   key("vio_max_rotation_rate_dps") << o.vio.max_rotation_rate_dps;
@@ -439,6 +451,7 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("max_prior_rejections") << o.max_prior_rejections;
   key("gate_conflict_epochs") << o.gate_conflict_epochs;
   key("reanchor_sigma_m") << o.reanchor_sigma_m;
+  key("vio_keep_s") << o.vio_keep_s;
   key("cn0_screen") << o.cn0.enabled;
   key("cn0_margin_db") << o.cn0.margin_db;
   key("cn0_quantile") << o.cn0.quantile;
