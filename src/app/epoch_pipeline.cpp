@@ -8,6 +8,7 @@
 
 #include <readerwriterqueue/readerwritercircularbuffer.h>
 
+#include "canyon/app/live_vio.hpp"
 #include "canyon/core/time.hpp"
 
 namespace canyon::app {
@@ -85,6 +86,7 @@ void RtkEstimator::resolve(EpochItem& item) {
 }
 
 void FusionEstimator::bridge(EpochItem& item) const {
+  if (live_vio_ != nullptr) live_vio_->await(item.rover.time);
   item.pose = engine_.bridge(item.rover.time);
 }
 

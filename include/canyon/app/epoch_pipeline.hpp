@@ -147,10 +147,14 @@ class RtkEstimator final : public EpochEstimator {
   mutable rtk::EpochGeometryBuilder geometry_;
 };
 
-/// The paper's fusion (fusion::FusionEngine).
+class LiveVio;
+
+/// The paper's fusion (fusion::FusionEngine). With a live VIO stream (app/live_vio.hpp) the time bridge first waits
+/// for the VIO to cover the epoch.
 class FusionEstimator final : public EpochEstimator {
  public:
-  explicit FusionEstimator(fusion::FusionEngine& engine) : engine_(engine) {}
+  explicit FusionEstimator(fusion::FusionEngine& engine, LiveVio* live_vio = nullptr)
+      : engine_(engine), live_vio_(live_vio) {}
   void bridge(EpochItem& item) const override;
   void align(EpochItem& item) override;
   void predict(EpochItem& item) override;
@@ -160,6 +164,7 @@ class FusionEstimator final : public EpochEstimator {
 
  private:
   fusion::FusionEngine& engine_;
+  LiveVio* live_vio_;
 };
 
 /// Receives each epoch after its last stage (on the ambiguity stage's thread); an error stops the pipeline.
