@@ -129,6 +129,7 @@ std::string MonitorModel::json_line(std::int64_t now_ns) const {
     j += std::string("\"") + kQueueNames[i] + "\":" + std::to_string(t != nullptr ? t->queue_full_waits[i] : 0);
   }
   j += "},\"drops\":{\"vio\":" + std::to_string(t != nullptr ? t->vio_dropped : 0) +
+       ",\"vio_late\":" + std::to_string(t != nullptr ? t->vio_late : 0) +
        ",\"base_late\":" + std::to_string(t != nullptr ? t->base_late : 0) +
        ",\"malformed\":" + std::to_string(t != nullptr ? t->malformed_samples : 0) +
        ",\"solutions\":" + std::to_string(lost_solutions_) + "}";
@@ -174,9 +175,11 @@ std::vector<std::string> MonitorModel::text(std::int64_t now_ns) const {
       q += std::string("  ") + kQueueNames[i] + " " + std::to_string(t.queue_depth[i]);
     }
     lines.push_back(q);
-    std::snprintf(line, sizeof line, "correction age %s s  drops: vio %llu, base late %llu, malformed %llu",
+    std::snprintf(line, sizeof line,
+                  "correction age %s s  drops: vio %llu, vio late %llu, base late %llu, malformed %llu",
                   number(t.correction_age_s, "%.2f").c_str(), static_cast<unsigned long long>(t.vio_dropped),
-                  static_cast<unsigned long long>(t.base_late), static_cast<unsigned long long>(t.malformed_samples));
+                  static_cast<unsigned long long>(t.vio_late), static_cast<unsigned long long>(t.base_late),
+                  static_cast<unsigned long long>(t.malformed_samples));
     lines.emplace_back(line);
     if (std::isfinite(t.alignment_rmse_m)) {
       std::snprintf(line, sizeof line, "alignment RMSE %.3f m  FER %.3f  lever arm [%.3f %.3f %.3f] m",

@@ -53,6 +53,11 @@ std::string RoverConfig::validate() const {
   if (rover == RoverInputKind::Ubx && e.rover_obs.empty()) e.rover_obs = "-";
   const bool streams_nav = stream_ephemerides && (rover == RoverInputKind::Ubx || streamed_base());
   if (streams_nav && e.nav.empty()) e.nav = {"-"};  // ephemerides from the streams only
+  if (vio_dds) {
+    if (estimator.mode != ProcessMode::Fusion) return "input.vio dds needs estimator.mode fusion";
+    if (e.vio.empty()) e.vio = "-";  // the VIO streams in
+    if (e.timesync.empty()) e.timesync = "-";
+  }
   if (const std::string s = e.validate(); !s.empty()) return "estimator: " + s;
   if (estimator.exclude_most_observed != 0) return "estimator.exclude_most_observed needs the whole file: batch only";
   if (rover_id.empty() || rover_id.size() > 64) return "rover_id must have 1 to 64 characters";
@@ -67,9 +72,14 @@ std::string RoverConfig::validate() const {
   if (const std::string l = link.validate(); !l.empty()) return "input.link_" + l;
   if (!(base_wait_s > 0.0 && base_wait_s <= 60.0)) return "input.base_wait_s must be in (0, 60]";
   if (base_queue_frames < 16 || base_queue_frames > 1000000) return "input.base_queue_frames must be in 16..1000000";
+  if (!(vio_wait_s >= 0.0 && vio_wait_s <= 10.0)) return "input.vio_wait_s must be in [0, 10]";
+  if (vio_queue_poses < 16 || vio_queue_poses > 1000000) return "input.vio_queue_poses must be in 16..1000000";
   if (const std::string s = pipeline.validate(); !s.empty()) return "pipeline." + s;
   if (domain < 0 || domain > 232) return "dds.domain must be in 0..232";
-  if (rtcm_topic.empty() || solution_topic.empty() || timing_topic.empty()) return "dds topics must not be empty";
+  if (rtcm_topic.empty() || solution_topic.empty() || timing_topic.empty() || vio_topic.empty() ||
+      timesync_topic.empty()) {
+    return "dds topics must not be empty";
+  }
   return {};
 }
 
@@ -120,6 +130,14 @@ Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string
   int frames = static_cast<int>(c.base_queue_frames);
   input.get("base_queue_frames", frames);
   c.base_queue_frames = frames < 0 ? 0 : static_cast<std::size_t>(frames);
+  std::string vio = c.vio_dds ? "dds" : "file";
+  input.get("vio", vio);
+  if (vio != "file" && vio != "dds") input.fail("vio", "must be file or dds, not '" + vio + "'");
+  c.vio_dds = vio == "dds";
+  input.get("vio_wait_s", c.vio_wait_s);
+  int poses = static_cast<int>(c.vio_queue_poses);
+  input.get("vio_queue_poses", poses);
+  c.vio_queue_poses = poses < 0 ? 0 : static_cast<std::size_t>(poses);
   input.reject_unknown_keys();
   YamlMap pipeline = top.sub("pipeline");
   pipeline.get("threaded", c.pipeline.threaded);
@@ -133,6 +151,8 @@ Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string
   dds.get("rtcm_topic", c.rtcm_topic);
   dds.get("solution_topic", c.solution_topic);
   dds.get("timing_topic", c.timing_topic);
+  dds.get("vio_topic", c.vio_topic);
+  dds.get("timesync_topic", c.timesync_topic);
   dds.get("publish_stages", c.publish_stages);
   dds.reject_unknown_keys();
   top.reject_unknown_keys();
@@ -162,6 +182,9 @@ std::string to_yaml(const RoverConfig& c) {
   out << YAML::Key << "link_stall_timeout_s" << YAML::Value << c.link.stall_timeout_s;
   out << YAML::Key << "base_wait_s" << YAML::Value << c.base_wait_s;
   out << YAML::Key << "base_queue_frames" << YAML::Value << c.base_queue_frames;
+  out << YAML::Key << "vio" << YAML::Value << (c.vio_dds ? "dds" : "file");
+  out << YAML::Key << "vio_wait_s" << YAML::Value << c.vio_wait_s;
+  out << YAML::Key << "vio_queue_poses" << YAML::Value << c.vio_queue_poses;
   out << YAML::EndMap;
   out << YAML::Key << "pipeline" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "threaded" << YAML::Value << c.pipeline.threaded;
@@ -173,6 +196,8 @@ std::string to_yaml(const RoverConfig& c) {
   out << YAML::Key << "rtcm_topic" << YAML::Value << c.rtcm_topic;
   out << YAML::Key << "solution_topic" << YAML::Value << c.solution_topic;
   out << YAML::Key << "timing_topic" << YAML::Value << c.timing_topic;
+  out << YAML::Key << "vio_topic" << YAML::Value << c.vio_topic;
+  out << YAML::Key << "timesync_topic" << YAML::Value << c.timesync_topic;
   out << YAML::Key << "publish_stages" << YAML::Value << c.publish_stages;
   out << YAML::EndMap;
   out << YAML::EndMap;

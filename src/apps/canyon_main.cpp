@@ -546,6 +546,8 @@ int run_main(int argc, char** argv) {
       ->allow_extras();
   app.add_subcommand("rover", "Real-time rover: the staged pipeline over DDS (runs canyon-rover; canyon rover --help)")
       ->allow_extras();
+  app.add_subcommand("vio", "Publish VIO poses and time-sync pairs from files on DDS, as a VIO node (runs canyon-vio)")
+      ->allow_extras();
   app.add_subcommand("record",
                      "Record a DDS topic to a file: solutions to .pos/NMEA/CSV, others to a replayable log "
                      "(runs canyon-record)")
@@ -603,7 +605,7 @@ int exec_dds_command(const std::string& command, int argc, char** argv) {
 int main(int argc, char** argv) {
   if (argc >= 2) {
     const std::string command = argv[1];
-    for (const char* dds : {"base", "rover", "record", "echo", "monitor"}) {
+    for (const char* dds : {"base", "rover", "vio", "record", "echo", "monitor"}) {
       if (command == dds) return exec_dds_command(command, argc, argv);
     }
   }

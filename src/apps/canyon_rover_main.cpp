@@ -1,5 +1,6 @@
 // canyon-rover: the real-time rover. The rover's observations replayed from RINEX at real-time pace (or faster),
-// base corrections from a RINEX file or from the DDS RtcmFrame topic, VIO from files, through the six-stage threaded
+// base corrections from a RINEX file or from the DDS RtcmFrame topic, VIO from files or from the DDS VioPose and
+// TimeSyncSample topics (app/live_vio.hpp), through the six-stage threaded
 // pipeline (app/epoch_pipeline.hpp, the same stages as canyon process); solutions and stage timing published on DDS
 // (idl/RoverPipeline.idl). `canyon rover ...` runs this executable; config/rover.yaml documents the configuration.
 // SIGINT/SIGTERM stop it cleanly: ingest stops, the epochs in flight are finished and published.
@@ -18,6 +19,7 @@
 #include <spdlog/spdlog.h>
 
 #include "canyon/app/epoch_pipeline.hpp"
+#include "canyon/app/live_vio.hpp"
 #include "canyon/app/observation_stream.hpp"
 #include "canyon/app/process.hpp"
 #include "canyon/app/rover_config.hpp"
@@ -143,6 +145,43 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
                          " needs estimator.base_position (the base's ECEF antenna position)"};
   }
   return input;
+}
+
+/// VIO over DDS: the live VIO feed of the fusion engine and the two readers that fill it (the listeners only queue).
+Status open_live_vio(const app::RoverConfig& config, pl::DdsParticipant& participant,
+                     canyon::fusion::FusionEngine& engine, std::unique_ptr<app::LiveVio>& live,
+                     std::unique_ptr<pl::VioPoseReader>& poses, std::unique_ptr<pl::TimeSyncReader>& pairs) {
+  app::LiveVioOptions options;
+  options.wait_s = config.vio_wait_s;
+  options.queue_poses = config.vio_queue_poses;
+  options.vio_on_gps_time = config.estimator.fusion.vio_on_gps_time;
+  options.time_sync = config.estimator.fusion.time_sync;
+  options.time_sync.causal = true;
+  if (const std::string e = options.validate(); !e.empty()) return canyon::Error{"input.vio dds: " + e};
+  live = std::make_unique<app::LiveVio>(engine, options, log_warning);
+  app::LiveVio* feed = live.get();
+  auto p = pl::VioPoseReader::create(participant, config.vio_topic, "vio_reader", [feed](canyon::msg::VioPose&& m) {
+    auto pose = pl::from_msg(m);
+    if (pose) {
+      feed->push_pose(std::move(*pose));
+    } else {
+      spdlog::warn("VIO: {} (sample dropped)", pose.error().message);
+    }
+  });
+  if (!p) return p.error();
+  poses = std::move(*p);
+  auto s = pl::TimeSyncReader::create(participant, config.timesync_topic, "vio_reader",
+                                      [feed](canyon::msg::TimeSyncSample&& m) {
+                                        auto pair = pl::from_msg(m);
+                                        if (pair) {
+                                          feed->push_pair(*pair);
+                                        } else {
+                                          spdlog::warn("VIO time sync: {} (sample dropped)", pair.error().message);
+                                        }
+                                      });
+  if (!s) return s.error();
+  pairs = std::move(*s);
+  return canyon::Ok{};
 }
 
 int run(int argc, char** argv) {
@@ -308,15 +347,26 @@ int run(int argc, char** argv) {
   std::unique_ptr<canyon::rtk::RtkEngine> rtk_engine;
   std::unique_ptr<canyon::fusion::FusionEngine> fusion_engine;
   std::unique_ptr<app::EpochEstimator> estimator;
+  std::unique_ptr<app::LiveVio> live_vio;
+  std::unique_ptr<pl::VioPoseReader> vio_reader;
+  std::unique_ptr<pl::TimeSyncReader> timesync_reader;
   if (est.mode == app::ProcessMode::Fusion) {
-    auto track = app::load_vio_track(est, notes);
+    auto track = config->vio_dds ? Result<canyon::fusion::VioTrack>(canyon::fusion::VioTrack::streaming(est.fusion.vio))
+                                 : app::load_vio_track(est, notes);
     if (!track) {
       spdlog::error("{}", track.error().to_string());
       return kExitRuntime;
     }
     fusion_engine =
         std::make_unique<canyon::fusion::FusionEngine>(est.fusion, est.rtk, ephemerides, p_E_base, std::move(*track));
-    estimator = std::make_unique<app::FusionEstimator>(*fusion_engine);
+    if (config->vio_dds) {
+      auto readers = open_live_vio(*config, **participant, *fusion_engine, live_vio, vio_reader, timesync_reader);
+      if (!readers) {
+        spdlog::error("{}", readers.error().to_string());
+        return kExitRuntime;
+      }
+    }
+    estimator = std::make_unique<app::FusionEstimator>(*fusion_engine, live_vio.get());
   } else {
     rtk_engine = std::make_unique<canyon::rtk::RtkEngine>(est.rtk, ephemerides, p_E_base);
     estimator = std::make_unique<app::RtkEstimator>(*rtk_engine);
@@ -363,7 +413,11 @@ int run(int argc, char** argv) {
     if (stage != app::Stage::Ambiguity) return;
     context.base_late = source.base_late();
     context.malformed_samples = pl::malformed_payloads();
-    context.vio_dropped = 0;
+    if (live_vio) {
+      const app::LiveVioCounts vio = live_vio->counts();
+      context.vio_dropped = vio.dropped;
+      context.vio_late = vio.late_epochs;
+    }
     if (pipeline_ptr != nullptr) {
       context.queue_depth = pipeline_ptr->queue_depths();
       context.queue_full_waits = pipeline_ptr->stats().full_waits;
@@ -409,7 +463,8 @@ int run(int argc, char** argv) {
   }
   spdlog::info(
       "rover '{}': {} mode, rover from {}, base from {}, {} pipeline, pace {}; publishing {} and {} on domain {}",
-      config->rover_id, app::mode_name(est.mode), rover_from, base_from,
+      config->rover_id, app::mode_name(est.mode), rover_from,
+      base_from + (config->vio_dds ? ", VIO from DDS " + config->vio_topic + " and " + config->timesync_topic : ""),
       config->pipeline.threaded ? "threaded" : "sequential", config->pace, config->solution_topic, config->timing_topic,
       config->domain);
   const auto start = std::chrono::steady_clock::now();
@@ -444,6 +499,14 @@ int run(int argc, char** argv) {
   if (feed.added() > 0) {
     spdlog::info("{} ephemerides from the streams (UBX SFRBX, RTCM 3) used besides the navigation files'",
                  feed.added());
+  }
+  if (live_vio) {
+    const app::LiveVioCounts c = live_vio->counts();
+    const bool problems = c.dropped > 0 || c.unmapped > 0 || c.out_of_order > 0 || c.late_epochs > 0;
+    spdlog::log(problems ? spdlog::level::warn : spdlog::level::info,
+                "VIO over DDS: {} poses and {} time-sync pairs received, {} poses used; {} dropped (queue full), {} "
+                "not mapped to GPST, {} out of order; {} epochs went on without waiting longer for their VIO",
+                c.poses, c.pairs, c.appended, c.dropped, c.unmapped, c.out_of_order, c.late_epochs);
   }
   if (fusion_engine) {
     for (const std::string& line : fusion_engine->report()) spdlog::info("{}", line);

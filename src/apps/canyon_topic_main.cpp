@@ -3,7 +3,8 @@
 //   record TOPIC --out FILE: canyon/solution to .pos (RTKLIB format), .nmea (GGA) or .csv (every sample, status 0
 //     too, with its sequence number and arrival time: the sequence accounting); canyon/rtcm to the raw
 //     RTCM 3 stream (replayable: canyon base input.kind rtcm3, canyon process base: FILE.rtcm3); canyon/timing and
-//     canyon/bridged to CSV.
+//     canyon/bridged to CSV; canyon/vio and canyon/timesync to vio.csv and timesync.csv (replayable: canyon vio;
+//     every value with 17 significant digits, so the replay carries the same numbers).
 //   echo TOPIC: one line per sample.
 //   monitor: per-stage and end-to-end latency percentiles, correction age, queues, drops and the solution, refreshed
 //     in the terminal or as JSON lines (--json; schema in app/monitor_model.hpp).
@@ -58,6 +59,33 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
+/// vio.csv's header (io/vio_file.hpp) with the 36 cross-covariance columns (zeros where a pose has none).
+std::string vio_csv_header() {
+  std::string h = "t_ns,px,py,pz,qx,qy,qz,qw";
+  for (int r = 0; r < 6; ++r) {
+    for (int c = r; c < 6; ++c) h += ",cov" + std::to_string(r) + std::to_string(c);
+  }
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) h += ",cross" + std::to_string(r) + std::to_string(c);
+  }
+  return h;
+}
+
+/// A vio.csv row of a VioPose, every value with 17 significant digits (read back exactly).
+std::string vio_csv_row(const canyon::msg::VioPose& m) {
+  std::string row = std::to_string(m.device_time_ns());
+  char value[32];
+  const auto add = [&](double v) {
+    std::snprintf(value, sizeof value, ",%.17g", v);
+    row += value;
+  };
+  for (const double v : m.p_O_m()) add(v);
+  for (const double v : m.q_OI_xyzw()) add(v);
+  for (const double v : m.covariance_upper()) add(v);
+  for (const double v : m.cross_previous()) add(m.has_cross_previous() ? v : 0.0);
+  return row;
+}
+
 /// The output of canyon record, written from the DDS listener thread (one reader: one thread at a time).
 class Recorder {
  public:
@@ -89,8 +117,8 @@ int run(int argc, char** argv) {
 #endif
   if (kTool != "monitor") {
     cli.add_option("topic", topic,
-                   "canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior or "
-                   "canyon/float")
+                   "canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior, "
+                   "canyon/float, canyon/vio or canyon/timesync")
         ->required();
   } else {
     cli.add_option("--solution-topic", solution_topic, "Solution topic");
@@ -123,13 +151,14 @@ int run(int argc, char** argv) {
   }
   if (kTool != "monitor") {
     bool known = false;
-    for (const char* suffix : {"solution", "timing", "rtcm", "bridged", "prior", "float", "alignment"}) {
+    for (const char* suffix :
+         {"solution", "timing", "rtcm", "bridged", "prior", "float", "alignment", "vio", "timesync"}) {
       known = known || ends_with(topic, suffix);
     }
     if (!known) {
       return fail("unknown topic '" + topic +
-                      "': canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior "
-                      "or canyon/float",
+                      "': canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior, "
+                      "canyon/float, canyon/vio or canyon/timesync",
                   kExitUsage);
     }
   }
@@ -183,6 +212,10 @@ int run(int argc, char** argv) {
       if (solutions) {
         raw << "seq,gps_week,gps_tow_s,status,x_m,y_m,z_m,lat_deg,lon_deg,height_m,n_sats,ratio,age_s,"
                "received_monotonic_ns\n";
+      } else if (ends_with(topic, "vio")) {
+        raw << vio_csv_header() << '\n';
+      } else if (ends_with(topic, "timesync")) {
+        raw << "t_ns,gps_week,gps_tow_s\n";
       }
     }
   }
@@ -319,6 +352,27 @@ int run(int argc, char** argv) {
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     alignment_reader = std::move(*r);
   }
+  std::unique_ptr<pl::VioPoseReader> vio_reader;
+  std::unique_ptr<pl::TimeSyncReader> timesync_reader;
+  if (kTool != "monitor" && ends_with(topic, "vio")) {
+    auto r = pl::VioPoseReader::create(**participant, topic, "vio_reader", [&](canyon::msg::VioPose&& m) {
+      if (kTool == "echo") return text_sample(pl::describe(m));
+      text_sample(vio_csv_row(m));
+    });
+    if (!r) return fail(r.error().to_string(), kExitRuntime);
+    vio_reader = std::move(*r);
+  }
+  if (kTool != "monitor" && ends_with(topic, "timesync")) {
+    auto r = pl::TimeSyncReader::create(**participant, topic, "vio_reader", [&](canyon::msg::TimeSyncSample&& m) {
+      if (kTool == "echo") return text_sample(pl::describe(m));
+      char line[96];
+      std::snprintf(line, sizeof line, "%lld,%d,%.17g", static_cast<long long>(m.device_time_ns()), m.gps_week(),
+                    m.gps_tow_s());
+      text_sample(line);
+    });
+    if (!r) return fail(r.error().to_string(), kExitRuntime);
+    timesync_reader = std::move(*r);
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
@@ -331,6 +385,8 @@ int run(int argc, char** argv) {
     if (prior_reader) n += prior_reader->matched();
     if (float_reader) n += float_reader->matched();
     if (alignment_reader) n += alignment_reader->matched();
+    if (vio_reader) n += vio_reader->matched();
+    if (timesync_reader) n += timesync_reader->matched();
     return n;
   };
   const auto start = std::chrono::steady_clock::now();

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <limits>
 
+#include <Eigen/Cholesky>
+
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
 
@@ -116,6 +118,7 @@ msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& c
   m.queue_depth(depth);
   m.queue_full_waits(waits);
   m.vio_dropped(context.vio_dropped);
+  m.vio_late(context.vio_late);
   m.base_late(context.base_late);
   m.malformed_samples(context.malformed_samples);
   m.alignment_rmse_m(context.alignment_rmse_m);
@@ -208,6 +211,100 @@ std::string describe(const msg::Alignment& m) {
   return line;
 }
 
+std::string describe(const msg::VioPose& m) {
+  char line[200];
+  std::snprintf(line, sizeof line, "vio #%llu t %lld ns p [%.3f %.3f %.3f] m q [%.4f %.4f %.4f %.4f]%s",
+                static_cast<unsigned long long>(m.sequence_number()), static_cast<long long>(m.device_time_ns()),
+                m.p_O_m()[0], m.p_O_m()[1], m.p_O_m()[2], m.q_OI_xyzw()[0], m.q_OI_xyzw()[1], m.q_OI_xyzw()[2],
+                m.q_OI_xyzw()[3], m.has_cross_previous() ? " (with cross-covariance)" : "");
+  return line;
+}
+
+std::string describe(const msg::TimeSyncSample& m) {
+  char line[120];
+  std::snprintf(line, sizeof line, "timesync t %lld ns = GPST %d %.9f", static_cast<long long>(m.device_time_ns()),
+                m.gps_week(), m.gps_tow_s());
+  return line;
+}
+
+msg::VioPose to_msg(const io::VioRecord& pose, std::uint64_t sequence_number) {
+  msg::VioPose m;
+  m.sequence_number(sequence_number);
+  m.device_time_ns(pose.t_ns);
+  m.p_O_m({pose.T_OI.p.x(), pose.T_OI.p.y(), pose.T_OI.p.z()});
+  m.q_OI_xyzw({pose.T_OI.q.x(), pose.T_OI.q.y(), pose.T_OI.q.z(), pose.T_OI.q.w()});
+  std::size_t k = 0;
+  for (int row = 0; row < 6; ++row) {
+    for (int col = row; col < 6; ++col) m.covariance_upper()[k++] = pose.covariance(row, col);
+  }
+  m.has_cross_previous(pose.cross_previous.has_value());
+  if (pose.cross_previous) {
+    k = 0;
+    for (int row = 0; row < 6; ++row) {
+      for (int col = 0; col < 6; ++col) m.cross_previous()[k++] = (*pose.cross_previous)(row, col);
+    }
+  }
+  m.send_monotonic_ns(core::pipeline_now_ns());
+  return m;
+}
+
+Result<io::VioRecord> from_msg(const msg::VioPose& m) {
+  const std::string which = "VioPose " + std::to_string(m.sequence_number());
+  const auto finite = [](const auto& values) {
+    return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+  };
+  if (!finite(m.p_O_m()) || !finite(m.q_OI_xyzw()) || !finite(m.covariance_upper()) ||
+      (m.has_cross_previous() && !finite(m.cross_previous()))) {
+    return Error{which + ": a value is not finite"};
+  }
+  io::VioRecord r;
+  r.t_ns = m.device_time_ns();
+  r.line = static_cast<int>(m.sequence_number() % 1000000000);
+  r.T_OI.p = Eigen::Vector3d(m.p_O_m()[0], m.p_O_m()[1], m.p_O_m()[2]);
+  const Eigen::Quaterniond q(m.q_OI_xyzw()[3], m.q_OI_xyzw()[0], m.q_OI_xyzw()[1], m.q_OI_xyzw()[2]);
+  const double norm = q.norm();
+  if (!(norm >= 0.5 && norm <= 1.5)) {
+    return Error{which + ": quaternion norm " + std::to_string(norm) + ", not a rotation"};
+  }
+  // A quaternion normalised by the sender stays bit for bit as sent.
+  r.T_OI.q = std::abs(norm - 1.0) <= 1e-12 ? q : q.normalized();
+  std::size_t k = 0;
+  for (int row = 0; row < 6; ++row) {
+    for (int col = row; col < 6; ++col) r.covariance(row, col) = r.covariance(col, row) = m.covariance_upper()[k++];
+  }
+  if (Eigen::LLT<core::Matrix6d>(r.covariance).info() != Eigen::Success) {
+    return Error{which + ": covariance is not positive definite"};
+  }
+  if (m.has_cross_previous()) {
+    core::Matrix6d c;
+    k = 0;
+    for (int row = 0; row < 6; ++row) {
+      for (int col = 0; col < 6; ++col) c(row, col) = m.cross_previous()[k++];
+    }
+    r.cross_previous = c;
+  }
+  return r;
+}
+
+msg::TimeSyncSample to_msg(const io::TimeSyncPair& pair) {
+  msg::TimeSyncSample m;
+  m.device_time_ns(pair.t_ns);
+  m.gps_week(pair.time.week);
+  m.gps_tow_s(pair.time.tow_s);
+  return m;
+}
+
+Result<io::TimeSyncPair> from_msg(const msg::TimeSyncSample& m) {
+  if (m.gps_week() < 0 || !(m.gps_tow_s() >= 0.0 && m.gps_tow_s() < core::kSecondsPerWeek)) {
+    return Error{"TimeSyncSample: GPS time " + std::to_string(m.gps_week()) + " " + std::to_string(m.gps_tow_s()) +
+                 " out of range"};
+  }
+  io::TimeSyncPair p;
+  p.t_ns = m.device_time_ns();
+  p.time = core::GpsTime{static_cast<int>(m.gps_week()), m.gps_tow_s()};
+  return p;
+}
+
 Result<core::Solution> from_msg(const msg::Solution& m) {
   const std::string which = "Solution " + std::to_string(m.sequence_number());
   const int status = m.status();
@@ -261,6 +358,7 @@ app::TimingSample to_sample(const msg::StageTiming& m) {
     s.queue_full_waits[i] = m.queue_full_waits()[i];
   }
   s.vio_dropped = m.vio_dropped();
+  s.vio_late = m.vio_late();
   s.base_late = m.base_late();
   s.malformed_samples = m.malformed_samples();
   s.alignment_rmse_m = m.alignment_rmse_m();

@@ -82,5 +82,33 @@ TEST(RoverConfig, ReceiverAndNetworkInputs) {
             std::string::npos);
 }
 
+TEST(RoverConfig, VioFromDds) {
+  const auto error = [](const std::string& yaml) {
+    auto c = parse_rover_config(YAML::Load(yaml), "rover.yaml");
+    if (!c) return c.error().to_string();
+    return c->validate();
+  };
+  const std::string fusion = "estimator: {mode: fusion, rover: r.obs, base: b.obs, nav: [n.rnx]}\n";
+  auto c = parse_rover_config(YAML::Load(fusion + "input: {vio: dds, vio_wait_s: 0.5, vio_queue_poses: 100}\n"
+                                                  "dds: {vio_topic: a/vio, timesync_topic: a/sync}\n"),
+                              "rover.yaml");
+  ASSERT_TRUE(c) << c.error().to_string();
+  EXPECT_EQ(c->validate(), "");  // no vio.csv or timesync.csv needed
+  EXPECT_TRUE(c->vio_dds);
+  EXPECT_EQ(c->vio_wait_s, 0.5);
+  EXPECT_EQ(c->vio_queue_poses, 100U);
+  EXPECT_EQ(c->vio_topic, "a/vio");
+  auto again = parse_rover_config(YAML::Load(to_yaml(*c)), "printed");
+  ASSERT_TRUE(again) << again.error().to_string();
+  EXPECT_TRUE(*again == *c);
+  EXPECT_NE(error(fusion + "input: {vio: udp}\n").find("file or dds"), std::string::npos);
+  EXPECT_NE(error(fusion + "input: {vio: dds, vio_wait_s: -1}\n").find("input.vio_wait_s"), std::string::npos);
+  EXPECT_NE(error(fusion + "input: {vio: dds, vio_queue_poses: 3}\n").find("input.vio_queue_poses"), std::string::npos);
+  EXPECT_NE(error("estimator: {mode: rtk, rover: r.obs, base: b.obs, nav: [n.rnx]}\ninput: {vio: dds}\n")
+                .find("needs estimator.mode fusion"),
+            std::string::npos);
+  EXPECT_NE(error(fusion).find("vio"), std::string::npos);  // from files, the files are required
+}
+
 }  // namespace
 }  // namespace canyon::app

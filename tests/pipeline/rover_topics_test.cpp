@@ -1,11 +1,13 @@
 // The rover's topics (idl/RoverPipeline.idl, pipeline/rover_msgs.hpp) over Fast DDS with the shipped profiles:
-//  - the Solution adapter round-trips what a .pos file needs, bit for bit, and refuses malformed messages;
+//  - the Solution adapter round-trips what a .pos file needs, bit for bit, and refuses malformed messages; so do
+//    the VIO pose and time-sync adapters (the rover fed over DDS sees the files' numbers exactly);
 //  - a subscriber that joins late gets every solution from its first one on, without a gap;
 //  - a publisher that restarts (a rover restarted) is matched again and its solutions arrive;
 //  - the monitor model's JSON line carries the schema's keys.
 
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -51,8 +53,12 @@ TEST(RoverMsgs, TimingCarriesTheDropCounts) {
   context.rover_id = "r1";
   context.base_late = 3;
   context.malformed_samples = 5;
+  context.vio_dropped = 7;
+  context.vio_late = 11;
   const app::TimingSample t = to_sample(to_msg_timing(solved_item(2), context));
   EXPECT_EQ(t.seq, 2U);
+  EXPECT_EQ(t.vio_dropped, 7U);
+  EXPECT_EQ(t.vio_late, 11U);
   EXPECT_EQ(t.base_late, 3U);
   EXPECT_EQ(t.malformed_samples, 5U);
 }
@@ -79,6 +85,50 @@ TEST(RoverMsgs, SolutionRoundTripsBitForBit) {
   bad = m;
   bad.pruned(std::vector<eprosima::fastrtps::fixed_string<4>>(200, "G01"));
   EXPECT_FALSE(from_msg(bad).ok());
+}
+
+TEST(RoverMsgs, VioPoseAndTimeSyncRoundTripBitForBitAndRefuseMalformed) {
+  io::VioRecord r;
+  r.t_ns = 1234567890123;
+  r.T_OI.p = Eigen::Vector3d(1.25, -3.5, 0.125e-3);
+  r.T_OI.q = Eigen::Quaterniond(0.9, 0.1, -0.3, 0.2).normalized();
+  core::Matrix6d a = core::Matrix6d::Random();
+  r.covariance = a * a.transpose() + core::Matrix6d::Identity() * 1e-3;
+  r.cross_previous = core::Matrix6d::Random() * 1e-4;
+  const msg::VioPose m = to_msg(r, 42);
+  EXPECT_EQ(m.sequence_number(), 42U);
+  auto back = from_msg(m);
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  EXPECT_EQ(back->t_ns, r.t_ns);
+  EXPECT_EQ(back->T_OI.p, r.T_OI.p);
+  EXPECT_EQ(back->T_OI.q.coeffs(), r.T_OI.q.coeffs());
+  EXPECT_EQ(back->covariance, r.covariance);
+  ASSERT_TRUE(back->cross_previous.has_value());
+  EXPECT_EQ(*back->cross_previous, *r.cross_previous);
+  r.cross_previous.reset();
+  EXPECT_FALSE(from_msg(to_msg(r, 43))->cross_previous.has_value());
+
+  msg::VioPose bad = m;
+  bad.q_OI_xyzw({0.0, 0.0, 0.0, 0.1});
+  EXPECT_NE(from_msg(bad).error().message.find("not a rotation"), std::string::npos);
+  bad = m;
+  bad.p_O_m({0.0, std::numeric_limits<double>::quiet_NaN(), 0.0});
+  EXPECT_NE(from_msg(bad).error().message.find("not finite"), std::string::npos);
+  bad = m;
+  auto cov = bad.covariance_upper();
+  cov[0] = -1.0;
+  bad.covariance_upper(cov);
+  EXPECT_NE(from_msg(bad).error().message.find("positive definite"), std::string::npos);
+
+  const io::TimeSyncPair pair{987654321, core::GpsTime{2266, 316800.123456789}, 0};
+  auto p = from_msg(to_msg(pair));
+  ASSERT_TRUE(p.ok());
+  EXPECT_EQ(p->t_ns, pair.t_ns);
+  EXPECT_EQ(p->time.week, 2266);
+  EXPECT_EQ(p->time.tow_s, pair.time.tow_s);
+  msg::TimeSyncSample out_of_range = to_msg(pair);
+  out_of_range.gps_tow_s(700000.0);
+  EXPECT_FALSE(from_msg(out_of_range).ok());
 }
 
 class RoverTopics : public ::testing::Test {
@@ -189,8 +239,9 @@ TEST(MonitorModel, JsonLineCarriesTheSchema) {
   const std::string j = model.json_line(2'000'000'000);
   for (const char* key :
        {"\"t_s\":2.000", "\"stages\":{\"ingest\":{\"p50_us\":0.5", "\"end_to_end\":{\"p50_us\":6.5",
-        "\"correction_age_s\":0.200", "\"queues\":{", R"("drops":{"vio":0,"base_late":0,"malformed":4,"solutions":2})",
-        "\"pruned\":[\"G05\"]", "\"alignment\":{\"rmse_m\":0.0200", "\"lever_arm_m\":[0.0000,0.0000,0.0000]"}) {
+        "\"correction_age_s\":0.200", "\"queues\":{",
+        R"("drops":{"vio":0,"vio_late":0,"base_late":0,"malformed":4,"solutions":2})", "\"pruned\":[\"G05\"]",
+        "\"alignment\":{\"rmse_m\":0.0200", "\"lever_arm_m\":[0.0000,0.0000,0.0000]"}) {
     EXPECT_NE(j.find(key), std::string::npos) << key << " not in " << j;
   }
   EXPECT_EQ(model.lost_solutions(), 2U);

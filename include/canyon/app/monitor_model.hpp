@@ -44,7 +44,8 @@ struct TimingSample {
   double correction_age_s = 0.0;  ///< NaN: no base
   std::array<std::uint32_t, kMonitorQueues> queue_depth{};
   std::array<std::uint64_t, kMonitorQueues> queue_full_waits{};
-  std::uint64_t vio_dropped = 0;
+  std::uint64_t vio_dropped = 0;  ///< VIO poses and pairs dropped (rover queue full)
+  std::uint64_t vio_late = 0;     ///< epochs that went on without their VIO
   std::uint64_t base_late = 0;
   std::uint64_t malformed_samples = 0;  ///< DDS samples the rover refused as malformed
   double alignment_rmse_m = 0.0;        ///< NaN: not aligned

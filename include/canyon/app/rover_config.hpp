@@ -31,12 +31,17 @@ struct RoverConfig {
   LinkOptions link;                ///< attempts, stall_timeout_s of the network links (rover and base)
   double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (streamed), from when it is due
   std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
-  PipelineOptions pipeline{true, 64};    ///< threaded, queue_capacity
-  int domain = 0;                        ///< DDS domain id
-  std::string profiles;                  ///< Fast DDS XML profiles ("": config/dds/canyon_profiles.xml)
+  bool vio_dds = false;                  ///< fusion: VIO and time sync from DDS (vio_topic, timesync_topic), not files
+  double vio_wait_s = 0.2;               ///< dds VIO: longest an epoch waits for the VIO to cover it (s)
+  std::size_t vio_queue_poses = 4096;  ///< dds VIO: poses between the DDS listener and the time bridge; beyond: dropped
+  PipelineOptions pipeline{true, 64};  ///< threaded, queue_capacity
+  int domain = 0;                      ///< DDS domain id
+  std::string profiles;                ///< Fast DDS XML profiles ("": config/dds/canyon_profiles.xml)
   std::string rtcm_topic = "canyon/rtcm";
   std::string solution_topic = "canyon/solution";
   std::string timing_topic = "canyon/timing";
+  std::string vio_topic = "canyon/vio";            ///< canyon::msg::VioPose in (input.vio dds)
+  std::string timesync_topic = "canyon/timesync";  ///< canyon::msg::TimeSyncSample in (input.vio dds)
   bool publish_stages = true;  ///< also canyon/bridged, canyon/alignment, canyon/prior, canyon/float
 
   /// Empty if usable, else the first broken rule.

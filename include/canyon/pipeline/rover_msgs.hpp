@@ -11,6 +11,7 @@
 #include "canyon/app/monitor_model.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
+#include "canyon/io/vio_file.hpp"
 #include "canyon/pipeline/dds.hpp"
 
 #include "RoverPipeline.h"
@@ -23,7 +24,8 @@ struct EpochContext {
   std::string rover_id;
   std::array<std::size_t, app::kNumStages - 1> queue_depth{};
   std::array<std::uint64_t, app::kNumStages - 1> queue_full_waits{};
-  std::uint64_t vio_dropped = 0;
+  std::uint64_t vio_dropped = 0;  ///< VIO poses and pairs dropped (app::LiveVio queue full)
+  std::uint64_t vio_late = 0;     ///< epochs that went on without their VIO (app::LiveVio)
   std::uint64_t base_late = 0;
   std::uint64_t malformed_samples = 0;  ///< DDS samples refused as malformed (GuardedPubSubType)
   double alignment_rmse_m = 0.0;        ///< NaN: not aligned
@@ -47,6 +49,14 @@ Result<core::Solution> from_msg(const msg::Solution& m);
 [[nodiscard]] app::SolutionSample to_sample(const msg::Solution& m, std::int64_t received_ns);
 [[nodiscard]] app::TimingSample to_sample(const msg::StageTiming& m);
 
+/// VIO poses and time-sync pairs (vio.csv and timesync.csv records) <-> messages, exactly (no value is rounded or
+/// re-normalised on the way, so a rover fed over DDS sees the numbers canyon process reads from the files). Error if
+/// the message is malformed: a non-finite value, a quaternion that is not a rotation, a GPS time out of range.
+[[nodiscard]] msg::VioPose to_msg(const io::VioRecord& pose, std::uint64_t sequence_number);
+Result<io::VioRecord> from_msg(const msg::VioPose& m);
+[[nodiscard]] msg::TimeSyncSample to_msg(const io::TimeSyncPair& pair);
+Result<io::TimeSyncPair> from_msg(const msg::TimeSyncSample& m);
+
 using SolutionWriter = DdsWriter<msg::Solution, msg::SolutionPubSubType>;
 using SolutionReader = DdsReader<msg::Solution, msg::SolutionPubSubType>;
 using TimingWriter = DdsWriter<msg::StageTiming, msg::StageTimingPubSubType>;
@@ -59,6 +69,10 @@ using FloatWriter = DdsWriter<msg::FloatSolution, msg::FloatSolutionPubSubType>;
 using FloatReader = DdsReader<msg::FloatSolution, msg::FloatSolutionPubSubType>;
 using AlignmentWriter = DdsWriter<msg::Alignment, msg::AlignmentPubSubType>;
 using AlignmentReader = DdsReader<msg::Alignment, msg::AlignmentPubSubType>;
+using VioPoseWriter = DdsWriter<msg::VioPose, msg::VioPosePubSubType>;
+using VioPoseReader = DdsReader<msg::VioPose, msg::VioPosePubSubType>;
+using TimeSyncWriter = DdsWriter<msg::TimeSyncSample, msg::TimeSyncSamplePubSubType>;
+using TimeSyncReader = DdsReader<msg::TimeSyncSample, msg::TimeSyncSamplePubSubType>;
 
 /// One line of text per message (canyon echo).
 [[nodiscard]] std::string describe(const msg::Solution& m);
@@ -67,5 +81,7 @@ using AlignmentReader = DdsReader<msg::Alignment, msg::AlignmentPubSubType>;
 [[nodiscard]] std::string describe(const msg::Prior& m);
 [[nodiscard]] std::string describe(const msg::FloatSolution& m);
 [[nodiscard]] std::string describe(const msg::Alignment& m);
+[[nodiscard]] std::string describe(const msg::VioPose& m);
+[[nodiscard]] std::string describe(const msg::TimeSyncSample& m);
 
 }  // namespace canyon::pipeline
