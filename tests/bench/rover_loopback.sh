@@ -3,7 +3,9 @@
 # DDS) -> canyon record (solutions to .pos) + canyon monitor (--json); a second canyon record keeps the RTCM stream
 # (canyon/rtcm) so that canyon process can run on exactly the base observations the rover received. Checks that
 # the recorded .pos records equal canyon process's (byte for byte, header lines aside: they name the programs) and
-# that no solution was lost, and prints the monitor's last figures.
+# that no solution was lost, and prints the monitor's last figures. urban-severe runs twice: the rover reading the
+# VIO files, and the rover fed by a fifth process, canyon vio, publishing the VIO poses and time-sync pairs on DDS
+# (compared with canyon process with fusion.timesync_mode causal, the mapping a live rover uses).
 #
 # Usage: tests/bench/rover_loopback.sh [instinct|urban-severe|both] [BUILD_DIR] [WORK_DIR]
 #   env BASE_PACE (default 20: base replay speed; the rover follows the base), SIM_DURATION_S (urban-severe, 60),
@@ -27,13 +29,15 @@ header_position() {  # APPROX POSITION XYZ of a RINEX file as "X, Y, Z"
   awk '/APPROX POSITION XYZ/ { printf "%s, %s, %s", $1, $2, $3; exit }' "$1"
 }
 
-# run NAME MODE ROVER BASE NAV ESTIMATOR_EXTRA_YAML(file with estimator keys, indented, or "")
+# run NAME MODE ROVER BASE NAV ESTIMATOR_EXTRA_YAML(file with estimator keys, indented, or "") [VIO_CSV TIMESYNC_CSV]
+# With VIO_CSV, canyon vio publishes it on DDS and the rover takes its VIO from there (input.vio dds).
 run() {
-  local name="$1" mode="$2" rover="$3" base="$4" nav="$5" extra="$6"
+  local name="$1" mode="$2" rover="$3" base="$4" nav="$5" extra="$6" vio_csv="${7:-}" timesync_csv="${8:-}"
   local dir="${work}/${name}"
   rm -rf "${dir}" && mkdir -p "${dir}"
-  local pos
+  local pos vio_source=file
   pos="$(header_position "${base}")"
+  [[ -n "${vio_csv}" ]] && vio_source=dds
   {
     echo "station: {id: 1}"
     echo "input: {kind: rinex, source: file, path: ${base}, nav: [${nav}], pace: ${base_pace}}"
@@ -44,13 +48,13 @@ run() {
   } > "${dir}/base.yaml"
   {
     echo "estimator:"
-    if [[ -n "${extra}" ]]; then sed 's/^/  /' "${extra}"; else echo "  mode: ${mode}"; fi
+    if [[ -n "${extra}" ]]; then sed 's/^/  /' "${extra}" | causal; else echo "  mode: ${mode}"; fi
     echo "  rover: ${rover}"
     echo "  nav: [${nav}]"
     echo "  base_position: [${pos}]"
-    [[ -f "${dir}/../${name}.vio" ]] && cat "${dir}/../${name}.vio"
+    [[ -z "${vio_csv}" && -f "${dir}/../${name}.vio" ]] && cat "${dir}/../${name}.vio"
     echo "rover_id: ${name}"
-    echo "input: {pace: 0, base: dds, base_wait_s: 5}"
+    echo "input: {pace: 0, base: dds, base_wait_s: 5, vio: ${vio_source}, vio_wait_s: 5}"
     echo "pipeline: {threaded: true, queue_capacity: 64}"
     echo "dds: {domain: ${domain}, profiles: ${profiles}}"
   } > "${dir}/rover.yaml"
@@ -66,6 +70,12 @@ run() {
   local mon=$!
   poll_dashboard "${dir}" &
   local poller=$!
+  local vio_pid=""
+  if [[ -n "${vio_csv}" ]]; then
+    "${canyon}" vio --vio "${vio_csv}" --timesync "${timesync_csv}" --pace 0 --wait-for-readers 1 --linger 120 \
+      --domain "${domain}" --profiles "${profiles}" > "${dir}/vio.log" 2>&1 &
+    vio_pid=$!
+  fi
   "${canyon}" rover --config "${dir}/rover.yaml" --wait-for-subscribers 2 > "${dir}/rover.log" 2>&1 &
   local rov=$!
   local start end
@@ -77,16 +87,21 @@ run() {
   local rover_rc=$?
   end=$(date +%s.%N)
   wait "${rec}" "${rec_rtcm}" "${mon}"
+  local vio_rc=0
+  if [[ -n "${vio_pid}" ]]; then
+    wait "${vio_pid}"
+    vio_rc=$?
+  fi
   kill "${poller}" 2> /dev/null
   wait "${poller}" 2> /dev/null
-  if ((base_rc != 0 || rover_rc != 0)); then
-    echo "rover_loopback ${name}: FAIL: base exit ${base_rc}, rover exit ${rover_rc} (logs in ${dir})"
+  if ((base_rc != 0 || rover_rc != 0 || vio_rc != 0)); then
+    echo "rover_loopback ${name}: FAIL: base exit ${base_rc}, rover exit ${rover_rc}, vio exit ${vio_rc} (logs in ${dir})"
     failures=$((failures + 1))
     return
   fi
   local process_yaml="${dir}/process.yaml"
   {
-    if [[ -n "${extra}" ]]; then cat "${extra}"; else echo "mode: ${mode}"; fi
+    if [[ -n "${extra}" ]]; then causal < "${extra}"; else echo "mode: ${mode}"; fi
     [[ -f "${dir}/../${name}.vio" ]] && sed 's/^  //' "${dir}/../${name}.vio"
   } > "${process_yaml}"
   "${canyon}" process -q --config "${process_yaml}" --rover "${rover}" --base "${dir}/base.rtcm3" --nav "${nav}" \
@@ -97,6 +112,9 @@ run() {
   n_rec=$(wc -l < "${dir}/recorded.records")
   n_proc=$(wc -l < "${dir}/process.records")
   lost=$(tail -n 1 "${dir}/monitor.jsonl" | sed -n 's/.*"lost_solutions":\([0-9]*\).*/\1/p')
+  if [[ -n "${vio_csv}" ]]; then
+    echo "rover_loopback ${name}: rover: $(grep -o 'VIO over DDS: .*' "${dir}/rover.log")"
+  fi
   if cmp -s "${dir}/recorded.records" "${dir}/process.records" && ((n_rec > 0)) && [[ "${lost}" == "0" ]]; then
     echo "rover_loopback ${name}: PASS: ${n_rec} solutions recorded = canyon process (byte for byte), 0 lost," \
       "$(awk -v s="${start}" -v e="${end}" 'BEGIN { printf "%.1f", e - s }') s wall (base pace ${base_pace})"
@@ -114,6 +132,11 @@ run() {
       "(${dir}/monitor.log)"
     failures=$((failures + 1))
   fi
+}
+
+# causal: stdin to stdout, with fusion.timesync_mode causal when CAUSAL=1.
+causal() {
+  if [[ "${CAUSAL:-0}" == 1 ]]; then sed 's/timesync_mode: whole_file/timesync_mode: causal/'; else cat; fi
 }
 
 # poll_dashboard DIR: while the monitor runs, fetch its /metrics every 0.5 s into DIR/dashboard_metrics.txt (the
@@ -156,6 +179,10 @@ if [[ "${which_runs}" == urban-severe || "${which_runs}" == both ]]; then
   else
     printf '  vio: %s\n  timesync: %s\n' "${sim}/vio.csv" "${sim}/timesync.csv" > "${work}/urban-severe.vio"
     run urban-severe fusion "${sim}/rover.obs" "${sim}/base.obs" "${sim}/nav.rnx" "${root}/config/fusion.yaml"
+    # The same with the VIO over DDS: canyon process then maps the VIO as the live rover does (causal).
+    printf '  vio: %s\n  timesync: %s\n' "${sim}/vio.csv" "${sim}/timesync.csv" > "${work}/urban-severe-vio-dds.vio"
+    CAUSAL=1 run urban-severe-vio-dds fusion "${sim}/rover.obs" "${sim}/base.obs" "${sim}/nav.rnx" \
+      "${root}/config/fusion.yaml" "${sim}/vio.csv" "${sim}/timesync.csv"
   fi
 fi
 exit $((failures > 0 ? 1 : 0))
