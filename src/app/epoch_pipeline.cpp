@@ -66,10 +66,12 @@ std::int64_t monotonic_ns() {
 // ---- Estimators: the engines' stages ----
 
 void RtkEstimator::bridge(EpochItem& item) const {
+  if (item.base_position_E_m) geometry_.set_base_position(*item.base_position_E_m);
   item.geometry.emplace(geometry_.build(item.rover, item.base ? &*item.base : nullptr));
 }
 
 void RtkEstimator::predict(EpochItem& item) {
+  if (item.base_position_E_m) engine_.set_base_position(*item.base_position_E_m);
   const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
   record_prediction(item, engine_.predict(item.rover, base, nullptr, item.geometry ? &*item.geometry : nullptr));
 }
@@ -95,6 +97,7 @@ void FusionEstimator::align(EpochItem& item) {
 }
 
 void FusionEstimator::predict(EpochItem& item) {
+  if (item.base_position_E_m) engine_.set_base_position(*item.base_position_E_m);
   const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
   record_prediction(item, engine_.predict(item.rover, base, item.pose));
 }

@@ -53,7 +53,8 @@ void LiveVio::warn_once(std::uint64_t count, const std::string& text) {
 bool LiveVio::drain() {
   io::TimeSyncPair pair;
   while (queues_->pair.try_dequeue(pair)) {
-    if (Status s = bridge_.add(pair); !s) warn_once(out_of_order_.fetch_add(1) + 1, "VIO time sync: " + s.error().message);
+    if (Status s = bridge_.add(pair); !s)
+      warn_once(out_of_order_.fetch_add(1) + 1, "VIO time sync: " + s.error().message);
   }
   bool any = false;
   io::VioRecord pose;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <thread>
 
 namespace canyon::app {
@@ -11,6 +12,7 @@ namespace {
 
 constexpr int kReadSliceMs = 100;  // a blocked read looks at the stop flag this often
 constexpr std::int64_t kPaceSliceNs = 50'000'000;
+constexpr double kSameBasePositionM = 1e-4;  // RTCM 1005's resolution: a smaller change is the same position
 
 io::GnssStreamOptions ubx_options() {
   io::GnssStreamOptions o;
@@ -182,7 +184,31 @@ Status RoverIngest::attach_base(EpochItem& item) {
   if (match.late) base_late_.fetch_add(1);
   if (match.epoch != nullptr) item.base = *match.epoch;
   item.base_send_ns = match.send_ns;
+  if (options_.base_position_from_stream && item.base) attach_base_position(item);
   return Ok{};
+}
+
+void RoverIngest::attach_base_position(EpochItem& item) {
+  const std::optional<Eigen::Vector3d> p = live_->station_position();
+  if (!p) {
+    // Without the base position the base epoch cannot be differenced: the rover epoch goes on alone.
+    if (base_without_position_.fetch_add(1) == 0) {
+      warn_(base_.name +
+            ": no base position yet (RTCM 1005/1006): rover epochs go on without the base until one "
+            "arrives (or give estimator.base_position)");
+    }
+    item.base.reset();
+    return;
+  }
+  if (base_position_ && (*p - *base_position_).norm() <= kSameBasePositionM) return;
+  if (base_position_) {
+    char moved[96];
+    std::snprintf(moved, sizeof moved, " (moved %.3f m)", (*p - *base_position_).norm());
+    warn_(base_.name + ": the base position changed" + moved + ": the new one is used from GPST " +
+          std::to_string(item.rover.time.week) + " " + std::to_string(item.rover.time.tow_s));
+  }
+  base_position_ = *p;
+  item.base_position_E_m = *p;
 }
 
 void RoverIngest::attach_navigation(EpochItem& item) {

@@ -102,7 +102,8 @@ Result<app::RoverInput> open_rover(const app::RoverConfig& config, const canyon:
 }
 
 /// The base's input and position: the RINEX file (position from estimator.base_position or its header), or a
-/// stream (DDS frames, an NTRIP or TCP link; position from estimator.base_position).
+/// stream (DDS frames, an NTRIP or TCP link; position from estimator.base_position, else from the stream's 1005/1006,
+/// handed to the stages with the epochs by RoverIngest).
 Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::io::ObsFilter& filter,
                                  const std::optional<core::GpsTime>& rover_start,
                                  moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& dds_frames,
@@ -140,11 +141,7 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
       break;
     }
   }
-  if (!est.base_position_E_m) {
-    return canyon::Error{std::string("input.base ") + app::rover_base_source_name(config.base) +
-                         " needs estimator.base_position (the base's ECEF antenna position)"};
-  }
-  return input;
+  return input;  // without estimator.base_position: the stream's 1005/1006 (RoverIngestOptions)
 }
 
 /// VIO over DDS: the live VIO feed of the fusion engine and the two readers that fill it (the listeners only queue).
@@ -389,6 +386,7 @@ int run(int argc, char** argv) {
   ingest_options.pace = config->pace;
   ingest_options.base_wait_s = config->base_wait_s;
   ingest_options.stream_ephemerides = config->stream_ephemerides;
+  ingest_options.base_position_from_stream = config->streamed_base() && !est.base_position_E_m;
   app::RoverIngest source(
       std::move(*rover), std::move(*base), ingest_options, [] { return g_stop.load(); }, log_warning);
   std::uint64_t solved = 0, fixed = 0, epochs = 0;
@@ -491,6 +489,14 @@ int run(int argc, char** argv) {
   }
   if (pl::malformed_payloads() > 0) {
     spdlog::warn("DDS: {} malformed samples dropped (packets corrupted on the way)", pl::malformed_payloads());
+  }
+  if (const auto& p = source.streamed_base_position()) {
+    spdlog::info("base position from the stream's RTCM 1005/1006: [{:.4f}, {:.4f}, {:.4f}] m ECEF", p->x(), p->y(),
+                 p->z());
+  }
+  if (source.base_without_position() > 0) {
+    spdlog::warn("base: {} epochs went on without the base: no base position (RTCM 1005/1006) had arrived yet",
+                 source.base_without_position());
   }
   if (source.base_late() > 0) {
     spdlog::warn("base: {} epochs went on without waiting longer for their base epoch (input.base_wait_s {})",

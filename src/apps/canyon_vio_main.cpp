@@ -186,8 +186,7 @@ int run(int argc, char** argv) {
                sync ? " and " + std::to_string(sync->pairs.size()) + " time-sync pairs on " + a.timesync_topic : "",
                a.domain, a.pace);
   const std::uint64_t refused = publish(a, *vio, sync ? &*sync : nullptr, w);
-  const bool acked =
-      w.poses->wait_for_acknowledgments(5.0) && (!w.pairs || w.pairs->wait_for_acknowledgments(5.0));
+  const bool acked = w.poses->wait_for_acknowledgments(5.0) && (!w.pairs || w.pairs->wait_for_acknowledgments(5.0));
   if (!acked) spdlog::warn("not every sample was acknowledged by every reader within 5 s");
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.linger_s);
   while (w.poses->matched() > 0 && std::chrono::steady_clock::now() < until && !g_stop.load()) {

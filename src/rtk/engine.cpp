@@ -1081,6 +1081,11 @@ Result<RtkEpoch> RtkEngine::process(const core::ObsEpoch& rover, const core::Obs
   return take_epoch();
 }
 
+void RtkEngine::set_base_position(const Eigen::Vector3d& p_E_base_m) {
+  p_E_base_m_ = p_E_base_m;
+  geometry_builder_.set_base_position(p_E_base_m);
+}
+
 Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding,
                                 EpochGeometry* geometry) {
   // The epoch's geometry (single-point solution, observables, satellite states): built ahead by the caller, or here.

@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include "canyon/io/rtcm3_station_stream.hpp"
 #include "canyon/net/stream_server.hpp"
 
 namespace canyon::app {
@@ -179,6 +180,85 @@ TEST(ReceiverStream, TruncatedAndCorruptLogsCostOnlyTheEpochsTheyHit) {
   EXPECT_EQ(static_cast<int>(c.epochs.size()), kRoverEpochs - 1);
   fs::remove(truncated);
   fs::remove(damaged);
+}
+
+}  // namespace
+}  // namespace canyon::app
+
+namespace canyon::app {
+namespace {
+
+/// A streamed base (instinct-spirent-rtk-sim's base RINEX as RTCM 3 MSM7, one base epoch per poll) whose 1005 starts
+/// only at its 5th epoch and moves by 1 m at its 20th: the rover epochs before the first 1005 go on without the base
+/// (counted), the first with it carries the position, the next ones do not (unchanged), the move is handed on.
+TEST(RoverIngest, StreamedBasePositionComesFromThe1005AndEpochsBeforeItGoOnWithoutTheBase) {
+  const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "instinct-spirent-rtk-sim/iono-Klob_tropo-Saast";
+  if (!fs::exists(data)) GTEST_SKIP() << "shared dataset not present: " << data;
+  io::ObsFilter filter = all_signals();
+  auto base_file = io::read_rinex_obs((data / "Base-static_MO_Spirent.obs").string(), filter);
+  ASSERT_TRUE(base_file) << base_file.error().to_string();
+  io::Rtcm3StationStreamOptions options;
+  options.station_interval_s = 1.0;
+  options.send_ephemerides = false;
+  io::Rtcm3StationStream encoder(options);
+  io::rtcm3::StationPosition station;
+  station.arp_E_m = Eigen::Vector3d(4157177.0658, 671230.4766, 4774767.0311);
+  std::vector<std::vector<std::uint8_t>> per_epoch;  // the frames of each base epoch, concatenated
+  for (std::size_t k = 0; k < 30 && k < base_file->epochs.size(); ++k) {
+    if (k == 4) encoder.set_station(station);
+    if (k == 19) {
+      station.arp_E_m.x() += 1.0;
+      encoder.set_station(station);
+    }
+    auto frames = encoder.epoch(base_file->epochs[k]);
+    ASSERT_TRUE(frames) << frames.error().to_string();
+    std::vector<std::uint8_t> bytes;
+    for (const io::Rtcm3Frame& f : *frames) bytes.insert(bytes.end(), f.bytes.begin(), f.bytes.end());
+    per_epoch.push_back(std::move(bytes));
+  }
+  auto rover = ObservationStream::open((data / "Rover-dynamic_MO_Spirent.obs").string(), filter);
+  ASSERT_TRUE(rover) << rover.error().to_string();
+  RoverInput rover_input;
+  rover_input.rinex.emplace(std::move(*rover));
+  BaseInput base;
+  std::size_t next = 0;
+  base.poll = [&](std::int64_t /*timeout_us*/, LiveBaseCursor& cursor) {
+    if (next == per_epoch.size()) return false;
+    cursor.push(per_epoch[next++], 0);
+    return true;
+  };
+  RoverIngestOptions ingest_options;
+  ingest_options.pace = 0.0;
+  ingest_options.base_position_from_stream = true;
+  std::vector<std::string> warnings;
+  RoverIngest ingest(
+      std::move(rover_input), std::move(base), ingest_options, [] { return false; },
+      [&](const std::string& w) { warnings.push_back(w); });
+  std::vector<EpochItem> items;
+  for (int k = 0; k < 25; ++k) {
+    auto item = ingest.next();
+    ASSERT_TRUE(item) << item.error().to_string();
+    ASSERT_TRUE(item->has_value());
+    items.push_back(std::move(**item));
+  }
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_FALSE(items[static_cast<std::size_t>(k)].base.has_value()) << k;
+    EXPECT_FALSE(items[static_cast<std::size_t>(k)].base_position_E_m.has_value()) << k;
+  }
+  ASSERT_TRUE(items[4].base.has_value());
+  ASSERT_TRUE(items[4].base_position_E_m.has_value());
+  EXPECT_LT((*items[4].base_position_E_m - Eigen::Vector3d(4157177.0658, 671230.4766, 4774767.0311)).norm(), 1e-4);
+  for (int k = 5; k < 19; ++k) {
+    EXPECT_TRUE(items[static_cast<std::size_t>(k)].base.has_value()) << k;
+    EXPECT_FALSE(items[static_cast<std::size_t>(k)].base_position_E_m.has_value()) << k;
+  }
+  ASSERT_TRUE(items[19].base_position_E_m.has_value());
+  EXPECT_NEAR(items[19].base_position_E_m->x() - items[4].base_position_E_m->x(), 1.0, 1e-4);
+  EXPECT_EQ(ingest.base_without_position(), 4U);
+  ASSERT_TRUE(ingest.streamed_base_position().has_value());
+  ASSERT_EQ(warnings.size(), 2U);
+  EXPECT_NE(warnings[0].find("no base position yet"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("moved 1.000 m"), std::string::npos) << warnings[1];
 }
 
 }  // namespace

@@ -51,7 +51,8 @@ run() {
     if [[ -n "${extra}" ]]; then sed 's/^/  /' "${extra}" | causal; else echo "  mode: ${mode}"; fi
     echo "  rover: ${rover}"
     echo "  nav: [${nav}]"
-    echo "  base_position: [${pos}]"
+    # STREAM_BASE_POSITION=1: no base position given, the rover takes it from the RTCM 1005 of the stream.
+    [[ "${STREAM_BASE_POSITION:-0}" == 1 ]] || echo "  base_position: [${pos}]"
     [[ -z "${vio_csv}" && -f "${dir}/../${name}.vio" ]] && cat "${dir}/../${name}.vio"
     echo "rover_id: ${name}"
     echo "input: {pace: 0, base: dds, base_wait_s: 5, vio: ${vio_source}, vio_wait_s: 5}"
@@ -104,8 +105,10 @@ run() {
     if [[ -n "${extra}" ]]; then causal < "${extra}"; else echo "mode: ${mode}"; fi
     [[ -f "${dir}/../${name}.vio" ]] && sed 's/^  //' "${dir}/../${name}.vio"
   } > "${process_yaml}"
+  local base_pos_args=(--base-pos "${pos// /}")
+  [[ "${STREAM_BASE_POSITION:-0}" == 1 ]] && base_pos_args=()  # the .rtcm3's 1005, as the rover
   "${canyon}" process -q --config "${process_yaml}" --rover "${rover}" --base "${dir}/base.rtcm3" --nav "${nav}" \
-    --base-pos "${pos// /}" --out "${dir}/process.pos" > "${dir}/process.log" 2>&1
+    "${base_pos_args[@]}" --out "${dir}/process.pos" > "${dir}/process.log" 2>&1
   grep -v '^%' "${dir}/recorded.pos" > "${dir}/recorded.records"
   grep -v '^%' "${dir}/process.pos" > "${dir}/process.records"
   local n_rec n_proc lost
@@ -164,7 +167,8 @@ if [[ "${which_runs}" == instinct || "${which_runs}" == both ]]; then
     echo "rover_loopback: shared data not found at ${inst}"
     [[ "${which_runs}" == instinct ]] && exit 77
   else
-    run instinct rtk "${inst}/iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs" \
+    # The rover is not given the base position: it takes it from the base's RTCM 1005.
+    STREAM_BASE_POSITION=1 run instinct rtk "${inst}/iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs" \
       "${inst}/iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs" "${inst}/RINEX_GN_Spirent.23N" \
       "${root}/config/rtk.yaml"
   fi

@@ -87,6 +87,10 @@ struct EpochItem {
   std::int64_t arrival_ns = 0;    ///< the epoch complete at ingest, rover and base (pipeline clock; 0: the pipeline
                                   ///< stamps it when the source returns it); the ingest stage is timed from it
   std::int64_t base_send_ns = 0;  ///< the base's send time of its epoch's last frame (DDS base; 0 otherwise)
+  /// A base position that arrived on the base's stream (RTCM 1005/1006) and holds from this epoch on; set by ingest
+  /// on the first epoch that has it and whenever it changes. The stages apply it with the epoch (the time bridge's
+  /// geometry, the prediction's engine), so threaded and sequential runs use the same position for the same epoch.
+  std::optional<Eigen::Vector3d> base_position_E_m;
   /// Ephemerides that arrived on the rover's or the base's stream before this epoch (nullptr: none). The pipeline
   /// hands them to EpochEstimator::add_navigation() before the epoch's time bridge, once every earlier epoch has
   /// left the last stage: no stage reads the ephemerides meanwhile, and threaded and sequential runs use the same

@@ -29,23 +29,23 @@
 namespace canyon::app {
 
 struct LiveVioOptions {
-  double wait_s = 0.2;                 ///< longest an epoch waits for the VIO to cover it (s)
-  std::size_t queue_poses = 4096;      ///< poses queued between the producer and the time bridge; beyond, dropped
-  std::size_t queue_pairs = 1024;      ///< time-sync pairs likewise
-  bool vio_on_gps_time = false;        ///< poses stamped with GPST ns (no pairs needed)
+  double wait_s = 0.2;                  ///< longest an epoch waits for the VIO to cover it (s)
+  std::size_t queue_poses = 4096;       ///< poses queued between the producer and the time bridge; beyond, dropped
+  std::size_t queue_pairs = 1024;       ///< time-sync pairs likewise
+  bool vio_on_gps_time = false;         ///< poses stamped with GPST ns (no pairs needed)
   fusion::TimeBridgeOptions time_sync;  ///< the causal bridge's fit (causal_hold_s, causal_window_pairs, limits)
 
   [[nodiscard]] std::string validate() const;
 };
 
 struct LiveVioCounts {
-  std::uint64_t poses = 0;          ///< received (queued or dropped)
-  std::uint64_t pairs = 0;          ///< received
-  std::uint64_t dropped = 0;        ///< poses and pairs dropped because their queue was full
-  std::uint64_t unmapped = 0;       ///< poses the causal time bridge could not map (no pair yet, fit refused)
-  std::uint64_t out_of_order = 0;   ///< poses and pairs not after the previous one (ignored)
-  std::uint64_t late_epochs = 0;    ///< epochs that went on without waiting longer for their VIO
-  std::uint64_t appended = 0;       ///< poses appended to the track
+  std::uint64_t poses = 0;         ///< received (queued or dropped)
+  std::uint64_t pairs = 0;         ///< received
+  std::uint64_t dropped = 0;       ///< poses and pairs dropped because their queue was full
+  std::uint64_t unmapped = 0;      ///< poses the causal time bridge could not map (no pair yet, fit refused)
+  std::uint64_t out_of_order = 0;  ///< poses and pairs not after the previous one (ignored)
+  std::uint64_t late_epochs = 0;   ///< epochs that went on without waiting longer for their VIO
+  std::uint64_t appended = 0;      ///< poses appended to the track
 };
 
 class LiveVio {
@@ -81,8 +81,7 @@ class LiveVio {
   fusion::CausalTimeBridge bridge_;
   std::deque<io::VioRecord> pending_;  // received, waiting for their time-sync pairs
   bool stalled_ = false;
-  std::atomic<std::uint64_t> poses_{0}, pairs_{0}, dropped_{0}, unmapped_{0}, out_of_order_{0}, late_{0},
-      appended_{0};
+  std::atomic<std::uint64_t> poses_{0}, pairs_{0}, dropped_{0}, unmapped_{0}, out_of_order_{0}, late_{0}, appended_{0};
 };
 
 }  // namespace canyon::app

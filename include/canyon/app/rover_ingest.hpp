@@ -106,6 +106,9 @@ struct RoverIngestOptions {
   double pace = 1.0;               ///< rover file replay speed (0: as fast as possible)
   double base_wait_s = 2.0;        ///< a streamed base: how long a rover epoch waits for its base epoch
   bool stream_ephemerides = true;  ///< hand the streams' ephemerides to the estimator (EpochItem::navigation)
+  /// A streamed base's position from its RTCM 1005/1006 (EpochItem::base_position_E_m); until the first arrives, the
+  /// rover epochs go on without a base (counted). False: the configured position is used, the stream's ignored.
+  bool base_position_from_stream = false;
 };
 
 class RoverIngest final : public EpochSource {
@@ -116,6 +119,10 @@ class RoverIngest final : public EpochSource {
 
   /// Rover epochs that went on without waiting longer for their base (streamed base).
   [[nodiscard]] std::uint64_t base_late() const { return base_late_.load(); }
+  /// Rover epochs that went on without their base because no 1005/1006 had given its position yet.
+  [[nodiscard]] std::uint64_t base_without_position() const { return base_without_position_.load(); }
+  /// The base position in use from the stream, once one arrived (call after the run).
+  [[nodiscard]] const std::optional<Eigen::Vector3d>& streamed_base_position() const { return base_position_; }
   /// The streamed base's decoder (nullptr before the first epoch or with a file base).
   [[nodiscard]] const LiveBaseCursor* live_base() const { return live_ ? &*live_ : nullptr; }
   /// What the streams delivered and lost, one line per stream (receiver, streamed base): bytes, bytes dropped,
@@ -132,6 +139,8 @@ class RoverIngest final : public EpochSource {
   /// Sleeps until the rover epoch at t is due at the replay pace; false if stopped meanwhile.
   bool wait_until_due(const core::GpsTime& t);
   Status attach_base(EpochItem& item);
+  /// The stream's base position for the epoch (base_position_from_stream), or no base while there is none.
+  void attach_base_position(EpochItem& item);
   void attach_navigation(EpochItem& item);
 
   RoverInput rover_;
@@ -144,6 +153,8 @@ class RoverIngest final : public EpochSource {
   ProblemReporter base_problems_;
   ReplayPacer pacer_;  // when a replayed rover epoch is due, and until when it waits for its base
   std::atomic<std::uint64_t> base_late_{0};
+  std::atomic<std::uint64_t> base_without_position_{0};
+  std::optional<Eigen::Vector3d> base_position_;  // from the stream, the last handed to an epoch
 };
 
 /// An estimator whose add_navigation() adds the ephemerides to the store the engine reads (the pipeline calls it

@@ -187,6 +187,8 @@ class FusionEngine {
   bool add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr);
   /// The track has the poses that make bridge(t) final (VioTrack::covers).
   [[nodiscard]] bool vio_covers(const core::GpsTime& t) const;
+  /// The base position from the next epoch on (rtk::RtkEngine::set_base_position).
+  void set_base_position(const Eigen::Vector3d& p_E_base_m) { engine_.set_base_position(p_E_base_m); }
   /// The lever arm t_IA in use (the prior until calibrated) (m, IMU frame).
   [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return t_IA_m_; }
 

@@ -198,8 +198,10 @@ class RtkEngine {
   /// The options of the engine's own geometry builder, for a builder that runs ahead (predict()).
   [[nodiscard]] EpochGeometryBuilder::Options geometry_options() const;
   [[nodiscard]] const gnss::EphemerisStore& ephemerides() const { return eph_; }
-  /// The base position the engine was made with (ECEF, m).
+  /// The base position in use (ECEF, m): the one the engine was made with, or the last set_base_position().
   [[nodiscard]] const Eigen::Vector3d& base_position_E_m() const { return p_E_base_m_; }
+  /// The base position from the next epoch on (a streamed base's RTCM 1005/1006); between predict()s.
+  void set_base_position(const Eigen::Vector3d& p_E_base_m);
   /// Measurement update (DD code and phase EKF with innovation gates and post-fit rejection) and the float solution;
   /// true if the epoch goes on to resolve() (AR on, float consistent), false if its result is final.
   bool update();

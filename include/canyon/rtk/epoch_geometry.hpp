@@ -75,6 +75,8 @@ class EpochGeometryBuilder {
   };
   EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m);
 
+  /// A new base position (RTCM 1005/1006 that arrived on a stream) for the epochs built from now on.
+  void set_base_position(const Eigen::Vector3d& p_E_base_m) { base_ = ReceiverGeometry(p_E_base_m); }
   /// The geometry of `rover` (and `base`, nullptr if none); continues the single-point chain when it solves.
   [[nodiscard]] EpochGeometry build(const core::ObsEpoch& rover, const core::ObsEpoch* base);
 
