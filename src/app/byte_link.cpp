@@ -117,6 +117,8 @@ class NetworkLink final : public ByteLink {
     return true;
   }
 
+  void set_gga(const std::string& sentence) override { client_.set_gga(sentence); }
+
   [[nodiscard]] LinkStats stats() const override {
     const net::StreamClientStats c = client_.stats();
     const std::lock_guard lock(mutex_);
@@ -137,6 +139,7 @@ class NetworkLink final : public ByteLink {
     o.stall_timeout_s = options.stall_timeout_s;
     o.backoff_min_s = options.backoff_min_s;
     o.backoff_max_s = options.backoff_max_s;
+    o.gga_interval_s = options.gga_interval_s;
     return o;
   }
 
@@ -195,6 +198,7 @@ std::string LinkOptions::validate() const {
   if (!(stall_timeout_s > 0.0)) return "stall_timeout_s must be > 0";
   if (!(backoff_min_s > 0.0 && backoff_max_s >= backoff_min_s)) return "backoff_min_s must be > 0 and <= backoff_max_s";
   if (max_queued_bytes < 4096) return "max_queued_bytes must be >= 4096";
+  if (!(gga_interval_s >= 0.0)) return "gga_interval_s must be >= 0";
   return {};
 }
 

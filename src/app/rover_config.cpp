@@ -71,6 +71,11 @@ std::string RoverConfig::validate() const {
   }
   if (const std::string l = link.validate(); !l.empty()) return "input.link_" + l;
   if (!(base_wait_s > 0.0 && base_wait_s <= 60.0)) return "input.base_wait_s must be in (0, 60]";
+  if (!(ntrip_gga_interval_s >= 0.0 && ntrip_gga_interval_s <= 3600.0)) {
+    return "input.ntrip_gga_interval_s must be in [0, 3600]";
+  }
+  if (ntrip_gga_interval_s > 0.0 && base != RoverBaseSource::Ntrip)
+    return "input.ntrip_gga_interval_s needs base ntrip";
   if (base_queue_frames < 16 || base_queue_frames > 1000000) return "input.base_queue_frames must be in 16..1000000";
   if (!(vio_wait_s >= 0.0 && vio_wait_s <= 10.0)) return "input.vio_wait_s must be in [0, 10]";
   if (vio_queue_poses < 16 || vio_queue_poses > 1000000) return "input.vio_queue_poses must be in 16..1000000";
@@ -127,6 +132,7 @@ Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string
   input.get("link_attempts", c.link.attempts);
   input.get("link_stall_timeout_s", c.link.stall_timeout_s);
   input.get("base_wait_s", c.base_wait_s);
+  input.get("ntrip_gga_interval_s", c.ntrip_gga_interval_s);
   int frames = static_cast<int>(c.base_queue_frames);
   input.get("base_queue_frames", frames);
   c.base_queue_frames = frames < 0 ? 0 : static_cast<std::size_t>(frames);
@@ -181,6 +187,7 @@ std::string to_yaml(const RoverConfig& c) {
   out << YAML::Key << "link_attempts" << YAML::Value << c.link.attempts;
   out << YAML::Key << "link_stall_timeout_s" << YAML::Value << c.link.stall_timeout_s;
   out << YAML::Key << "base_wait_s" << YAML::Value << c.base_wait_s;
+  out << YAML::Key << "ntrip_gga_interval_s" << YAML::Value << c.ntrip_gga_interval_s;
   out << YAML::Key << "base_queue_frames" << YAML::Value << c.base_queue_frames;
   out << YAML::Key << "vio" << YAML::Value << (c.vio_dds ? "dds" : "file");
   out << YAML::Key << "vio_wait_s" << YAML::Value << c.vio_wait_s;

@@ -25,6 +25,7 @@
 #include "canyon/app/rover_config.hpp"
 #include "canyon/app/rover_ingest.hpp"
 #include "canyon/gnss/ephemeris.hpp"
+#include "canyon/io/nmea.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/pipeline/dds.hpp"
 #include "canyon/pipeline/rover_msgs.hpp"
@@ -107,7 +108,7 @@ Result<app::RoverInput> open_rover(const app::RoverConfig& config, const canyon:
 Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::io::ObsFilter& filter,
                                  const std::optional<core::GpsTime>& rover_start,
                                  moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& dds_frames,
-                                 Eigen::Vector3d& p_E_base) {
+                                 Eigen::Vector3d& p_E_base, std::shared_ptr<app::ByteLink>& base_link) {
   const app::ProcessConfig& est = config.estimator;
   app::BaseInput input;
   if (est.base_position_E_m) p_E_base = *est.base_position_E_m;
@@ -132,12 +133,15 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
     case app::RoverBaseSource::Tcp: {
       auto address = app::LinkAddress::parse(config.base_source);
       if (!address) return address.error();
-      auto link = app::ByteLink::open(*address, config.link, link_log("base"));
+      app::LinkOptions options = config.link;
+      options.gga_interval_s = config.ntrip_gga_interval_s;  // ntrip only (validated)
+      auto link = app::ByteLink::open(*address, options, link_log("base"));
       if (!link) return link.error();
       std::shared_ptr<app::ByteLink> shared(std::move(*link));
       input.poll = app::link_base_poll(shared, log_warning);
       input.name = "base " + address->text;
-      input.link = std::move(shared);
+      input.link = shared;
+      base_link = std::move(shared);
       break;
     }
   }
@@ -336,7 +340,8 @@ int run(int argc, char** argv) {
   const std::optional<core::GpsTime> rover_start =
       rover->rinex ? rover->rinex->header().first_obs : std::optional<core::GpsTime>{};
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
-  auto base = open_base(*config, filter, rover_start, base_frames, p_E_base);
+  std::shared_ptr<app::ByteLink> base_link;  // ntrip, tcp: the link (the rover's position goes up as GGA)
+  auto base = open_base(*config, filter, rover_start, base_frames, p_E_base, base_link);
   if (!base) {
     spdlog::error("{}: {}", config_file, base.error().to_string());
     return kExitUsage;
@@ -396,6 +401,9 @@ int run(int argc, char** argv) {
     if (item.output) {
       ++solved;
       if (item.output->solution.status == core::SolutionStatus::Fixed) ++fixed;
+      if (base_link && config->ntrip_gga_interval_s > 0.0) {
+        base_link->set_gga(canyon::io::format_gga(item.output->solution));  // uploaded at the link's interval
+      }
       if (pos) return pos->write(item.output->solution);
     }
     return canyon::Ok{};

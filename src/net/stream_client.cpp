@@ -69,7 +69,6 @@ std::string StreamClientOptions::validate() const {
   if (!(stall_timeout_s > 0.0)) return "stall timeout must be > 0 s";
   if (!(backoff_min_s > 0.0) || backoff_max_s < backoff_min_s) return "back-off must satisfy 0 < min <= max";
   if (gga_interval_s < 0.0) return "GGA interval must be >= 0 s";
-  if (gga_interval_s > 0.0 && gga.empty()) return "GGA upload needs a GGA sentence";
   return {};
 }
 
@@ -93,6 +92,11 @@ void StreamClient::stop() {
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
   finished_ = true;
+}
+
+void StreamClient::set_gga(std::string sentence) {
+  const std::lock_guard lock(mutex_);
+  options_.gga = std::move(sentence);
 }
 
 StreamClientStats StreamClient::stats() const {
@@ -214,9 +218,13 @@ bool StreamClient::session() {
       data.clear();
       last_data = Clock::now();
     }
+    std::string line;
     if (options_.mode == StreamClientOptions::Mode::Ntrip && options_.gga_interval_s > 0.0 &&
         seconds_since(last_gga) >= options_.gga_interval_s) {
-      std::string line = options_.gga;
+      const std::lock_guard lock(mutex_);
+      line = options_.gga;
+    }
+    if (!line.empty()) {
       if (line.size() < 2 || line.substr(line.size() - 2) != "\r\n") line += "\r\n";
       if (Status s = send_all(*fd, line, options_.connect_timeout_ms); !s.ok()) {
         fail(where + ": GGA upload: " + s.error().message);

@@ -68,6 +68,13 @@ TEST(RoverConfig, ReceiverAndNetworkInputs) {
             std::string::npos);
   EXPECT_NE(error(est + "input: {rover: ubx, base: dds}\n").find("input.rover_source is required"), std::string::npos);
   EXPECT_NE(error(est + "input: {rover: sbf}\n").find("rinex or ubx"), std::string::npos);
+  EXPECT_EQ(error(est + "input: {base: ntrip, base_source: 'ntrip://h:1/M', ntrip_gga_interval_s: 5}\n"), "");
+  EXPECT_NE(
+      error(est + "input: {base: tcp, base_source: 'tcp://h:1', ntrip_gga_interval_s: 5}\n").find("needs base ntrip"),
+      std::string::npos);
+  EXPECT_NE(error(est + "input: {base: ntrip, base_source: 'ntrip://h:1/M', ntrip_gga_interval_s: -1}\n")
+                .find("input.ntrip_gga_interval_s"),
+            std::string::npos);
   EXPECT_NE(error(est + "input: {base: dds, link_attempts: -1}\n").find("input.link_attempts"), std::string::npos);
   // A malformed address is an error naming the file, the line and the key.
   const std::string bad = error(est + "input:\n  rover: ubx\n  rover_source: 'usb:/dev/x'\n");

@@ -144,8 +144,10 @@ part_base_canyon() {
     echo "  tcp: {enabled: true, bind: 127.0.0.1, port: ${tcp_port}}"
     echo "log: {progress_interval_s: 0}"
   } > base.yaml
+  # The NTRIP rover uploads its position as GGA every second (network RTK); the caster logs the first one.
   rover_yaml rover_ntrip "$(inst_estimator)" \
-    "pace: 0, base: ntrip, base_source: 'ntrip://rover:s3cret@127.0.0.1:${ntrip_port}/CANYON', base_wait_s: 5"
+    "pace: 0, base: ntrip, base_source: 'ntrip://rover:s3cret@127.0.0.1:${ntrip_port}/CANYON', base_wait_s: 5,
+    ntrip_gga_interval_s: 1"
   rover_yaml rover_tcp "$(inst_estimator)" \
     "pace: 0, base: tcp, base_source: 'tcp://127.0.0.1:${tcp_port}', base_wait_s: 5"
   timeout 120 "${canyon}" record canyon/rtcm --out base.rtcm3 --domain "${domain}" 2> record_rtcm.log &
@@ -160,7 +162,7 @@ part_base_canyon() {
   timeout 120 "${canyon}" rover --config rover_badauth.yaml --out badauth.pos > rover_badauth.log 2>&1 &
   local r3=$!
   # Three clients: the NTRIP rover, the TCP rover, the RTCM recorder (DDS).
-  timeout 120 "${canyon}" base --config base.yaml --wait-for-clients 3 -q > base.log 2>&1
+  timeout 120 "${canyon}" base --config base.yaml --wait-for-clients 3 > base.log 2>&1
   local base_rc=$?
   wait "${r1}"
   rc[ntrip]=$?
@@ -177,6 +179,13 @@ part_base_canyon() {
   else
     fail base-canyon "rover with a wrong NTRIP password: exit ${badauth_rc}, no 401 reported or the password shown" \
       "(${dir}/rover_badauth.log)"
+  fi
+  local gga
+  gga=$(grep -m1 -o 'sends GGA: \$G[A-Z]GGA,[^ ]*' base.log)
+  if [[ -n "${gga}" ]]; then
+    pass base-canyon "the NTRIP rover uploaded its position, the caster received: ${gga}"
+  else
+    fail base-canyon "no GGA from the NTRIP rover reached canyon base's caster (${dir}/base.log)"
   fi
   check_two_rovers base-canyon "${dir}"
 }

@@ -158,6 +158,31 @@ TEST(StreamServer, NtripVersionsOneAndTwoWithAuthentication) {
   EXPECT_TRUE(logged_v2);
 }
 
+TEST(StreamServer, GgaGoesUpOnlyOnceTheRoverHasAPositionAndFollowsIt) {
+  auto server = StreamServer::start(caster_options());
+  ASSERT_TRUE(server.ok());
+  Sink sink;
+  StreamClientOptions c = client_options((*server)->port(), 2);
+  c.gga_interval_s = 0.1;  // no sentence yet: nothing is sent until set_gga()
+  StreamClient client(c, sink.data(), sink.event());
+  ASSERT_TRUE(client.start().ok());
+  ASSERT_TRUE(wait_for([&] { return (*server)->stats().clients == 1; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  EXPECT_EQ((*server)->stats().gga_received, 0U);
+  EXPECT_EQ(client.stats().gga_sent, 0U);
+  const std::string first = "$GPGGA,120000.00,5316.8280,N,00903.4706,W,1,08,1.0,60.0,M,0.0,M,,*47";
+  client.set_gga(first);
+  ASSERT_TRUE(wait_for([&] { return (*server)->stats().gga_received >= 1; }));
+  const std::string second = "$GPGGA,120001.00,5316.8281,N,00903.4706,W,4,09,0.9,60.1,M,0.0,M,1.0,0001*7B";
+  client.set_gga(second);
+  const auto received = (*server)->stats().gga_received;
+  ASSERT_TRUE(wait_for([&] { return (*server)->stats().gga_received >= received + 2; }));
+  bool logged = false;
+  for (const auto& e : (*server)->take_events()) logged = logged || e.find("sends GGA") != std::string::npos;
+  EXPECT_TRUE(logged);  // the caster logs the first sentence of a client
+  EXPECT_GE(client.stats().gga_sent, 3U);
+}
+
 TEST(StreamServer, RefusesWrongCredentialsAndUnknownMountPoints) {
   StreamServerOptions o = caster_options();
   o.user = "rover";

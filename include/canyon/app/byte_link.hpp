@@ -45,6 +45,7 @@ struct LinkOptions {
   double backoff_min_s = 0.5;                ///< network: first wait before reconnecting (doubles up to backoff_max_s)
   double backoff_max_s = 8.0;                ///< network: longest wait between attempts
   std::size_t max_queued_bytes = 16u << 20;  ///< network: bytes received and not read yet; beyond: dropped, counted
+  double gga_interval_s = 0.0;               ///< ntrip: upload the set_gga() sentence this often (0: never)
 
   /// Empty if usable, else the broken rule.
   [[nodiscard]] std::string validate() const;
@@ -72,6 +73,9 @@ class ByteLink {
   virtual Result<bool> read(std::vector<std::uint8_t>& out, int timeout_ms) = 0;
   [[nodiscard]] virtual LinkStats stats() const = 0;
   [[nodiscard]] const LinkAddress& address() const { return address_; }
+  /// ntrip: the NMEA GGA sentence to upload every LinkOptions::gga_interval_s from now on (the rover's position, for
+  /// network RTK casters that compute corrections for it); other links ignore it. Thread-safe.
+  virtual void set_gga(const std::string& /*sentence*/) {}
 
  protected:
   explicit ByteLink(LinkAddress address) : address_(std::move(address)) {}

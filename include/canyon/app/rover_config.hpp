@@ -30,6 +30,7 @@ struct RoverConfig {
   bool stream_ephemerides = true;  ///< add the ephemerides of the UBX (SFRBX) and RTCM streams to estimator.nav's
   LinkOptions link;                ///< attempts, stall_timeout_s of the network links (rover and base)
   double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (streamed), from when it is due
+  double ntrip_gga_interval_s = 0.0;  ///< base ntrip: upload the rover's latest position as GGA this often (0: never)
   std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
   bool vio_dds = false;                  ///< fusion: VIO and time sync from DDS (vio_topic, timesync_topic), not files
   double vio_wait_s = 0.2;               ///< dds VIO: longest an epoch waits for the VIO to cover it (s)

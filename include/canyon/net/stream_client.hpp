@@ -34,7 +34,8 @@ struct StreamClientOptions {
   std::string password;
   int ntrip_version = 2;
   double gga_interval_s = 0.0;  ///< 0: no GGA upload
-  std::string gga;              ///< the sentence to upload (e.g. the rover's approximate position)
+  std::string gga;              ///< the sentence to upload (e.g. the rover's approximate position); empty: none until
+                                ///< set_gga() gives one
   // Robustness.
   int connect_timeout_ms = 5000;
   double stall_timeout_s = 10.0;
@@ -68,6 +69,8 @@ class StreamClient {
   Status start();
   /// Stops it (within about 100 ms) and waits.
   void stop();
+  /// The GGA sentence to upload from now on (the rover's latest position; thread-safe).
+  void set_gga(std::string sentence);
   /// Whether the thread gave up (max_attempts) or was stopped.
   [[nodiscard]] bool finished() const { return finished_.load(); }
   [[nodiscard]] StreamClientStats stats() const;
