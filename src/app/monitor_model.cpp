@@ -133,6 +133,13 @@ std::string MonitorModel::json_line(std::int64_t now_ns) const {
        ",\"base_late\":" + std::to_string(t != nullptr ? t->base_late : 0) +
        ",\"malformed\":" + std::to_string(t != nullptr ? t->malformed_samples : 0) +
        ",\"solutions\":" + std::to_string(lost_solutions_) + "}";
+  const auto link = [](const LinkCounts& c) {
+    return "{\"dropped_bytes\":" + std::to_string(c.dropped_bytes) +
+           ",\"failures\":" + std::to_string(c.link_failures) + ",\"bad_frames\":" + std::to_string(c.bad_frames) +
+           ",\"undecodable\":" + std::to_string(c.undecodable) + "}";
+  };
+  j += ",\"links\":{\"rover\":" + link(t != nullptr ? t->rover_link : LinkCounts{}) +
+       ",\"base\":" + link(t != nullptr ? t->base_link : LinkCounts{}) + "}";
   if (last_solution_) {
     const SolutionSample& s = *last_solution_;
     j += ",\"solution\":{\"seq\":" + std::to_string(s.seq) + ",\"status\":" + std::to_string(s.status) +
@@ -181,6 +188,12 @@ std::vector<std::string> MonitorModel::text(std::int64_t now_ns) const {
                   static_cast<unsigned long long>(t.vio_late), static_cast<unsigned long long>(t.base_late),
                   static_cast<unsigned long long>(t.malformed_samples));
     lines.emplace_back(line);
+    const auto link = [](const char* name, const LinkCounts& c) {
+      return std::string(name) + " dropped " + std::to_string(c.dropped_bytes) + " B, " +
+             std::to_string(c.link_failures) + " failed connections, " + std::to_string(c.bad_frames) + " bad, " +
+             std::to_string(c.undecodable) + " undecodable";
+    };
+    lines.push_back("links: " + link("rover", t.rover_link) + "; " + link("base", t.base_link));
     if (std::isfinite(t.alignment_rmse_m)) {
       std::snprintf(line, sizeof line, "alignment RMSE %.3f m  FER %.3f  lever arm [%.3f %.3f %.3f] m",
                     t.alignment_rmse_m, t.alignment_eigen_ratio, t.lever_arm_m.x(), t.lever_arm_m.y(),

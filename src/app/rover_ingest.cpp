@@ -39,7 +39,25 @@ RoverIngest::Summary stream_summary(const std::string& name, const ByteLink* lin
   return {std::move(text), problems};
 }
 
+LinkCounts link_counts(const ByteLink* link, const io::GnssStreamDecoder& d) {
+  LinkCounts c;
+  const io::GnssStreamStats s = d.stats();
+  c.bad_frames = s.framing.bad_packets();
+  c.undecodable = s.rtcm3_decode_errors + s.ubx_decode_errors;
+  if (link != nullptr) {
+    const LinkStats l = link->stats();
+    c.dropped_bytes = l.dropped_bytes;
+    c.link_failures = l.failures;
+  }
+  return c;
+}
+
 }  // namespace
+
+void RoverIngest::attach_link_counts(EpochItem& item) const {
+  if (rover_.receiver) item.rover_link = link_counts(&rover_.receiver->link(), rover_.receiver->decoder());
+  if (live_) item.base_link = link_counts(base_.link.get(), live_->decoder());
+}
 
 std::vector<RoverIngest::Summary> RoverIngest::summary() const {
   std::vector<Summary> out;
@@ -146,6 +164,7 @@ Result<std::optional<EpochItem>> RoverIngest::next() {
   if (!wait_until_due(item->rover.time)) return std::optional<EpochItem>{};  // stopped
   if (Status s = attach_base(*item); !s) return s.error();
   attach_navigation(*item);
+  attach_link_counts(*item);
   item->arrival_ns = core::pipeline_now_ns();  // the epoch is complete (rover and base) and enters the stages
   return item;
 }

@@ -121,6 +121,11 @@ msg::StageTiming to_msg_timing(const app::EpochItem& item, const EpochContext& c
   m.vio_late(context.vio_late);
   m.base_late(context.base_late);
   m.malformed_samples(context.malformed_samples);
+  const auto losses = [](const app::LinkCounts& c) {
+    return std::array<std::uint64_t, 4>{c.dropped_bytes, c.link_failures, c.bad_frames, c.undecodable};
+  };
+  m.rover_link_losses(losses(item.rover_link));
+  m.base_link_losses(losses(item.base_link));
   m.alignment_rmse_m(context.alignment_rmse_m);
   m.alignment_eigen_ratio(context.alignment_eigen_ratio);
   m.lever_arm_m({context.lever_arm_m.x(), context.lever_arm_m.y(), context.lever_arm_m.z()});
@@ -361,6 +366,9 @@ app::TimingSample to_sample(const msg::StageTiming& m) {
   s.vio_late = m.vio_late();
   s.base_late = m.base_late();
   s.malformed_samples = m.malformed_samples();
+  const auto counts = [](const std::array<std::uint64_t, 4>& a) { return app::LinkCounts{a[0], a[1], a[2], a[3]}; };
+  s.rover_link = counts(m.rover_link_losses());
+  s.base_link = counts(m.base_link_losses());
   s.alignment_rmse_m = m.alignment_rmse_m();
   s.alignment_eigen_ratio = m.alignment_eigen_ratio();
   s.lever_arm_m = Eigen::Vector3d(m.lever_arm_m()[0], m.lever_arm_m()[1], m.lever_arm_m()[2]);

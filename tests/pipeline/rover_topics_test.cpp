@@ -55,7 +55,14 @@ TEST(RoverMsgs, TimingCarriesTheDropCounts) {
   context.malformed_samples = 5;
   context.vio_dropped = 7;
   context.vio_late = 11;
-  const app::TimingSample t = to_sample(to_msg_timing(solved_item(2), context));
+  app::EpochItem item = solved_item(2);
+  item.rover_link = app::LinkCounts{1, 2, 3, 4};
+  item.base_link = app::LinkCounts{5, 6, 7, 8};
+  const app::TimingSample t = to_sample(to_msg_timing(item, context));
+  EXPECT_EQ(t.rover_link.dropped_bytes, 1U);
+  EXPECT_EQ(t.rover_link.undecodable, 4U);
+  EXPECT_EQ(t.base_link.link_failures, 6U);
+  EXPECT_EQ(t.base_link.bad_frames, 7U);
   EXPECT_EQ(t.seq, 2U);
   EXPECT_EQ(t.vio_dropped, 7U);
   EXPECT_EQ(t.vio_late, 11U);
@@ -237,11 +244,12 @@ TEST(MonitorModel, JsonLineCarriesTheSchema) {
   s.seq = 3;  // two lost
   model.add_solution(s);
   const std::string j = model.json_line(2'000'000'000);
-  for (const char* key :
-       {"\"t_s\":2.000", "\"stages\":{\"ingest\":{\"p50_us\":0.5", "\"end_to_end\":{\"p50_us\":6.5",
-        "\"correction_age_s\":0.200", "\"queues\":{",
-        R"("drops":{"vio":0,"vio_late":0,"base_late":0,"malformed":4,"solutions":2})", "\"pruned\":[\"G05\"]",
-        "\"alignment\":{\"rmse_m\":0.0200", "\"lever_arm_m\":[0.0000,0.0000,0.0000]"}) {
+  for (
+      const char* key :
+      {"\"t_s\":2.000", "\"stages\":{\"ingest\":{\"p50_us\":0.5", "\"end_to_end\":{\"p50_us\":6.5",
+       "\"correction_age_s\":0.200", "\"queues\":{",
+       R"("drops":{"vio":0,"vio_late":0,"base_late":0,"malformed":4,"solutions":2},"links":{"rover":{"dropped_bytes":0,"failures":0,"bad_frames":0,"undecodable":0},"base":{"dropped_bytes":0)",
+       "\"pruned\":[\"G05\"]", "\"alignment\":{\"rmse_m\":0.0200", "\"lever_arm_m\":[0.0000,0.0000,0.0000]"}) {
     EXPECT_NE(j.find(key), std::string::npos) << key << " not in " << j;
   }
   EXPECT_EQ(model.lost_solutions(), 2U);

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "canyon/app/link_counts.hpp"
 #include "canyon/core/ephemeris.hpp"
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
@@ -91,6 +92,8 @@ struct EpochItem {
   /// on the first epoch that has it and whenever it changes. The stages apply it with the epoch (the time bridge's
   /// geometry, the prediction's engine), so threaded and sequential runs use the same position for the same epoch.
   std::optional<Eigen::Vector3d> base_position_E_m;
+  LinkCounts rover_link;  ///< the receiver's stream (ubx input), as ingest left it with this epoch
+  LinkCounts base_link;   ///< the base's stream (dds, ntrip, tcp)
   /// Ephemerides that arrived on the rover's or the base's stream before this epoch (nullptr: none). The pipeline
   /// hands them to EpochEstimator::add_navigation() before the epoch's time bridge, once every earlier epoch has
   /// left the last stage: no stage reads the ephemerides meanwhile, and threaded and sequential runs use the same

@@ -14,7 +14,10 @@
 //    "base_to_solution": {same},  // base's send of the epoch's last RTCM frame -> solution received here (DDS base)
 //    "correction_age_s": latest rover - base epoch time (null: no base),
 //    "queues": {"ingest>time_bridge"|...: depth}, "queue_full_waits": {same: count},
-//    "drops": {"vio": count, "base_late": count, "malformed": DDS samples refused, "solutions": lost solutions},
+//    "drops": {"vio": count, "vio_late": count, "base_late": count, "malformed": DDS samples refused,
+//              "solutions": lost solutions},
+//    "links": {"rover": LINK, "base": LINK}, LINK = {"dropped_bytes", "failures", "bad_frames", "undecodable"}
+//              (the receiver's and the correction stream's losses so far; zeros for files),
 //    "solution": {"seq","status","lat_deg","lon_deg","height_m","n_sats","pruned":["G05",...],"ratio"} or null,
 //    "alignment": {"rmse_m","eigen_ratio","lever_arm_m":[x,y,z]} or null}
 // Percentiles are over the last `window` samples (nearest rank).
@@ -28,6 +31,8 @@
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "canyon/app/link_counts.hpp"
 
 namespace canyon::app {
 
@@ -48,6 +53,8 @@ struct TimingSample {
   std::uint64_t vio_late = 0;     ///< epochs that went on without their VIO
   std::uint64_t base_late = 0;
   std::uint64_t malformed_samples = 0;  ///< DDS samples the rover refused as malformed
+  LinkCounts rover_link;                ///< the receiver's stream's losses so far
+  LinkCounts base_link;                 ///< the correction stream's losses so far
   double alignment_rmse_m = 0.0;        ///< NaN: not aligned
   double alignment_eigen_ratio = 0.0;
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();

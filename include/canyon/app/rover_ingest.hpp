@@ -142,6 +142,8 @@ class RoverIngest final : public EpochSource {
   /// The stream's base position for the epoch (base_position_from_stream), or no base while there is none.
   void attach_base_position(EpochItem& item);
   void attach_navigation(EpochItem& item);
+  /// The streams' loss counts so far (EpochItem::rover_link, base_link).
+  void attach_link_counts(EpochItem& item) const;
 
   RoverInput rover_;
   BaseInput base_;
