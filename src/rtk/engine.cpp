@@ -955,13 +955,16 @@ std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full
 }
 
 std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
-                                                     int min_size, std::optional<Fix>& imprecise) const {
+                                                     int min_size, std::optional<Fix>& imprecise,
+                                                     bool last_subset_tried) const {
   // First prune satellites from the full set. Then leave out whole groups or constellations (signals that the two
   // receivers track differently bias a whole group): the accepted subset with the most ambiguities, or else the
   // best of pruning the kPrunedSubsets subsets closest to passing (highest ratio). At most
   // 2 + (1 + kPrunedSubsets) max_pruned_satellites + (number of exclusions) integer searches per epoch. Before all
   // that, the subset of the last fix still tracked: in continuous mode it usually passes again (one search).
-  if (auto again = last_subset_fix(dd_ambiguities(sds, Exclusion{}), min_size)) return again;
+  if (!last_subset_tried) {
+    if (auto again = last_subset_fix(dd_ambiguities(sds, Exclusion{}), min_size)) return again;
+  }
   if (full) {
     if (auto combinations = success_rate_subset_fix(*full, min_size)) {
       if (!combinations->imprecise) return combinations;
@@ -1007,8 +1010,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   // again only every kFullSetRetryEpochs epochs (or when the set changes). One epoch more of data seldom turns a
   // failing set around, and each integer search of the full set costs as much as the rest of the epoch.
   std::optional<Fix> best;
+  bool last_subset_tried = false;  // and failed: partial fixing need not search it again
   if (options_.partial_ar && all_keys == failed_full_set_ && epochs_since_full_set_ < kFullSetRetryEpochs) {
     best = last_subset_fix(all, min_size);
+    last_subset_tried = true;
     ++epochs_since_full_set_;
   }
   if (best) {
@@ -1022,7 +1027,8 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
       failed_full_set_ = all_keys;
       const std::string why = !best ? std::string("integer search failed") : rejection_reason(*best);
       std::optional<Fix> imprecise;
-      best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size, imprecise) : std::nullopt;
+      best = options_.partial_ar ? partial_fix(sds, std::move(best), min_size, imprecise, last_subset_tried)
+                                 : std::nullopt;
       if (!best) {
         out.note = why;
         if (imprecise) {

@@ -306,9 +306,11 @@ class RtkEngine {
   [[nodiscard]] static bool better_fix(const Fix& l, const Fix& r);
   /// Partial fixing after the full set failed: pruning, then without each group or constellation.
   /// `imprecise`: set to a partial fix by the success rate that passed its tests but leaves the position less precise
-  /// than max_partial_fix_sigma_m (not a fix, but a better float position).
+  /// than max_partial_fix_sigma_m (not a fix, but a better float position). `last_subset_tried`: the subset of the
+  /// last fix was searched this epoch already, and failed (the same search would fail again).
   [[nodiscard]] std::optional<Fix> partial_fix(const std::vector<SingleDiff>& sds, std::optional<Fix> full,
-                                               int min_size, std::optional<Fix>& imprecise) const;
+                                               int min_size, std::optional<Fix>& imprecise,
+                                               bool last_subset_tried) const;
   /// MLAMBDA and the ratio test, then partial fixing without one group if the whole set fails; fills the fixed
   /// solution of `out` and returns true when fixed.
   bool resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out);
