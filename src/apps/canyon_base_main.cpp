@@ -84,16 +84,7 @@ int run(int argc, char** argv) {
   std::unique_ptr<canyon::pipeline::DdsParticipant> participant;
   std::unique_ptr<canyon::pipeline::RtcmWriter> writer;
   if (config->dds.enabled) {
-    std::string profiles = config->dds.profiles;
-    if (profiles.empty()) {
-      auto found = canyon::pipeline::default_profiles_file();
-      if (!found) {
-        spdlog::error("{}", found.error().to_string());
-        return kExitUsage;
-      }
-      profiles = *found;
-    }
-    if (auto s = canyon::pipeline::load_profiles(profiles); !s.ok()) {
+    if (auto s = canyon::pipeline::load_profiles_or_default(config->dds.profiles); !s.ok()) {
       spdlog::error("{}", s.error().to_string());
       return kExitUsage;
     }
@@ -110,7 +101,7 @@ int run(int argc, char** argv) {
     }
     writer = std::move(*w);
     spdlog::info("DDS: publishing canyon::msg::RtcmFrame on topic '{}', domain {} (profiles {})", config->dds.topic,
-                 config->dds.domain, profiles);
+                 config->dds.domain, config->dds.profiles.empty() ? "shipped" : config->dds.profiles);
   }
 
   auto base = canyon::app::BaseStation::create(*config, [](const std::string& line) { spdlog::info("{}", line); });

@@ -247,16 +247,7 @@ int run(int argc, char** argv) {
                                                                            : shown(config->base_source);
 
   // DDS first: profiles before any participant.
-  std::string profiles = config->profiles;
-  if (profiles.empty()) {
-    auto found = pl::default_profiles_file();
-    if (!found) {
-      spdlog::error("{}", found.error().to_string());
-      return kExitUsage;
-    }
-    profiles = *found;
-  }
-  if (auto s = pl::load_profiles(profiles); !s.ok()) {
+  if (auto s = pl::load_profiles_or_default(config->profiles); !s.ok()) {
     spdlog::error("{}", s.error().to_string());
     return kExitUsage;
   }

@@ -168,15 +168,7 @@ int run(int argc, char** argv) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : kExitUsage;
   }
-  if (profiles.empty()) {
-    auto found = canyon::pipeline::default_profiles_file();
-    if (!found) {
-      std::cerr << "canyon-rtcm-probe: " << found.error().to_string() << "\n";
-      return kExitUsage;
-    }
-    profiles = *found;
-  }
-  if (auto s = canyon::pipeline::load_profiles(profiles); !s.ok()) {
+  if (auto s = canyon::pipeline::load_profiles_or_default(profiles); !s.ok()) {
     std::cerr << "canyon-rtcm-probe: " << s.error().to_string() << "\n";
     return kExitUsage;
   }

@@ -162,12 +162,7 @@ int run(int argc, char** argv) {
                   kExitUsage);
     }
   }
-  if (profiles.empty()) {
-    auto found = pl::default_profiles_file();
-    if (!found) return fail(found.error().to_string(), kExitUsage);
-    profiles = *found;
-  }
-  if (auto s = pl::load_profiles(profiles); !s.ok()) return fail(s.error().to_string(), kExitUsage);
+  if (auto s = pl::load_profiles_or_default(profiles); !s.ok()) return fail(s.error().to_string(), kExitUsage);
 #ifdef CANYON_WITH_DASHBOARD
   std::unique_ptr<canyon::dashboard::DashboardServer> dashboard;
   if (http_port >= 0) {

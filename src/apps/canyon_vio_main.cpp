@@ -144,16 +144,7 @@ int run(int argc, char** argv) {
     sync = std::move(*s);
   }
 
-  std::string profiles = a.profiles;
-  if (profiles.empty()) {
-    auto found = pl::default_profiles_file();
-    if (!found) {
-      spdlog::error("{}", found.error().to_string());
-      return kExitUsage;
-    }
-    profiles = *found;
-  }
-  if (auto s = pl::load_profiles(profiles); !s.ok()) {
+  if (auto s = pl::load_profiles_or_default(a.profiles); !s.ok()) {
     spdlog::error("{}", s.error().to_string());
     return kExitUsage;
   }

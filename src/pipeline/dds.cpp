@@ -38,6 +38,13 @@ Status load_profiles(const std::string& path) {
   return Ok{};
 }
 
+Status load_profiles_or_default(const std::string& path) {
+  if (!path.empty()) return load_profiles(path);
+  auto found = default_profiles_file();
+  if (!found) return found.error();
+  return load_profiles(*found);
+}
+
 Result<std::unique_ptr<DdsParticipant>> DdsParticipant::create(int domain, const std::string& profile) {
   fdds::DomainParticipant* p =
       fdds::DomainParticipantFactory::get_instance()->create_participant_with_profile(domain, profile);

@@ -39,6 +39,8 @@ namespace fdds = eprosima::fastdds::dds;
 Result<std::string> default_profiles_file();
 /// Loads Fast DDS XML profiles; call before creating participants. Loading the same file again is a no-op.
 Status load_profiles(const std::string& path);
+/// load_profiles(path), or the shipped file (default_profiles_file()) when `path` is empty.
+Status load_profiles_or_default(const std::string& path);
 
 class DdsParticipant {
  public:
