@@ -62,6 +62,13 @@ bool LiveVio::drain() {
     pending_.push_back(std::move(pose));
     any = true;
   }
+  // Poses whose time-sync pairs never come (a silent time-sync stream) are not kept without bound: beyond a queue's
+  // worth, the oldest are given up and counted as not mapped.
+  while (pending_.size() > options_.queue_poses) {
+    warn_once(unmapped_.fetch_add(1) + 1, "VIO pose at device time " + std::to_string(pending_.front().t_ns) +
+                                              " ns given up: no time-sync pair for it arrived");
+    pending_.pop_front();
+  }
   return any;
 }
 

@@ -163,6 +163,14 @@ TEST(LiveVio, AFullQueueDropsAndCounts) {
   EXPECT_EQ(c.poses, 100U);
   EXPECT_GE(c.dropped, 100U - 17U);  // the circular buffer's capacity is rounded up to a power of two at most
   EXPECT_LE(c.dropped, 100U - 16U);
+  // Without time-sync pairs no pose can be mapped: a queue's worth waits, older ones are given up and counted.
+  for (std::size_t k = 100; k < 140; ++k) {
+    live.await(run.sync.pairs.front().time);  // takes what is queued; waits 0 s
+    live.push_pose(run.vio.records[k]);
+  }
+  live.await(run.sync.pairs.front().time);
+  EXPECT_EQ(live.counts().appended, 0U);
+  EXPECT_EQ(live.counts().unmapped, 16U + 40U - 16U);  // the 16 queued and 40 pushed, of which 16 still wait
   LiveVioOptions no_room = options;
   no_room.queue_poses = 0;
   EXPECT_FALSE(no_room.validate().empty());

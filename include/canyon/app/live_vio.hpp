@@ -42,7 +42,8 @@ struct LiveVioCounts {
   std::uint64_t poses = 0;         ///< received (queued or dropped)
   std::uint64_t pairs = 0;         ///< received
   std::uint64_t dropped = 0;       ///< poses and pairs dropped because their queue was full
-  std::uint64_t unmapped = 0;      ///< poses the causal time bridge could not map (no pair yet, fit refused)
+  std::uint64_t unmapped = 0;      ///< poses the causal time bridge could not map (no pair yet, fit refused, or
+                                   ///< none came while a queue's worth of later poses waited)
   std::uint64_t out_of_order = 0;  ///< poses and pairs not after the previous one (ignored)
   std::uint64_t late_epochs = 0;   ///< epochs that went on without waiting longer for their VIO
   std::uint64_t appended = 0;      ///< poses appended to the track
