@@ -20,25 +20,6 @@ io::GnssStreamOptions ubx_options() {
   return o;
 }
 
-RoverIngest::Summary stream_summary(const std::string& name, const ByteLink* link, const io::GnssStreamDecoder& d,
-                                    std::uint64_t epochs) {
-  const io::GnssStreamStats s = d.stats();
-  const std::uint64_t undecodable = s.rtcm3_decode_errors + s.ubx_decode_errors;
-  std::string text = name + ": ";
-  bool problems = s.framing.bad_packets() > 0 || undecodable > 0;
-  if (link != nullptr) {
-    const LinkStats l = link->stats();
-    text += std::to_string(l.bytes) + " bytes, " + std::to_string(l.dropped_bytes) + " dropped (queue full), " +
-            std::to_string(l.failures) + " failed connection attempts; ";
-    problems = problems || l.dropped_bytes > 0 || l.failures > 0;
-  }
-  text += std::to_string(s.framing.rtcm3_frames) + " RTCM 3 frames, " + std::to_string(s.framing.ubx_packets) +
-          " UBX packets, " + std::to_string(s.framing.bad_packets()) + " bad or cut, " +
-          std::to_string(s.framing.garbage_bytes) + " garbage bytes, " + std::to_string(undecodable) +
-          " undecodable; " + std::to_string(epochs) + " epochs";
-  return {std::move(text), problems};
-}
-
 LinkCounts link_counts(const ByteLink* link, const io::GnssStreamDecoder& d) {
   LinkCounts c;
   const io::GnssStreamStats s = d.stats();
@@ -50,6 +31,23 @@ LinkCounts link_counts(const ByteLink* link, const io::GnssStreamDecoder& d) {
     c.link_failures = l.failures;
   }
   return c;
+}
+
+RoverIngest::Summary stream_summary(const std::string& name, const ByteLink* link, const io::GnssStreamDecoder& d,
+                                    std::uint64_t epochs) {
+  const io::GnssStreamStats s = d.stats();
+  const LinkCounts lost = link_counts(link, d);
+  std::string text = name + ": ";
+  if (link != nullptr) {
+    text += std::to_string(link->stats().bytes) + " bytes, " + std::to_string(lost.dropped_bytes) +
+            " dropped (queue full), " + std::to_string(lost.link_failures) + " failed connection attempts; ";
+  }
+  text += std::to_string(s.framing.rtcm3_frames) + " RTCM 3 frames, " + std::to_string(s.framing.ubx_packets) +
+          " UBX packets, " + std::to_string(lost.bad_frames) + " bad or cut, " +
+          std::to_string(s.framing.garbage_bytes) + " garbage bytes, " + std::to_string(lost.undecodable) +
+          " undecodable; " + std::to_string(epochs) + " epochs";
+  const bool problems = lost.bad_frames > 0 || lost.undecodable > 0 || lost.dropped_bytes > 0 || lost.link_failures > 0;
+  return {std::move(text), problems};
 }
 
 }  // namespace

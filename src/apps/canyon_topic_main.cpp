@@ -28,6 +28,7 @@
 #include "canyon/app/monitor_model.hpp"
 #include "canyon/io/nmea.hpp"
 #include "canyon/io/pos_file.hpp"
+#include "canyon/io/vio_file.hpp"
 #include "canyon/pipeline/dds.hpp"
 #include "canyon/pipeline/rover_msgs.hpp"
 #include "canyon/pipeline/rtcm_frame.hpp"
@@ -57,33 +58,6 @@ extern "C" void on_signal(int /*signal*/) {
 
 bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-/// vio.csv's header (io/vio_file.hpp) with the 36 cross-covariance columns (zeros where a pose has none).
-std::string vio_csv_header() {
-  std::string h = "t_ns,px,py,pz,qx,qy,qz,qw";
-  for (int r = 0; r < 6; ++r) {
-    for (int c = r; c < 6; ++c) h += ",cov" + std::to_string(r) + std::to_string(c);
-  }
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) h += ",cross" + std::to_string(r) + std::to_string(c);
-  }
-  return h;
-}
-
-/// A vio.csv row of a VioPose, every value with 17 significant digits (read back exactly).
-std::string vio_csv_row(const canyon::msg::VioPose& m) {
-  std::string row = std::to_string(m.device_time_ns());
-  char value[32];
-  const auto add = [&](double v) {
-    std::snprintf(value, sizeof value, ",%.17g", v);
-    row += value;
-  };
-  for (const double v : m.p_O_m()) add(v);
-  for (const double v : m.q_OI_xyzw()) add(v);
-  for (const double v : m.covariance_upper()) add(v);
-  for (const double v : m.cross_previous()) add(m.has_cross_previous() ? v : 0.0);
-  return row;
 }
 
 /// The output of canyon record, written from the DDS listener thread (one reader: one thread at a time).
@@ -208,7 +182,7 @@ int run(int argc, char** argv) {
         raw << "seq,gps_week,gps_tow_s,status,x_m,y_m,z_m,lat_deg,lon_deg,height_m,n_sats,ratio,age_s,"
                "received_monotonic_ns\n";
       } else if (ends_with(topic, "vio")) {
-        raw << vio_csv_header() << '\n';
+        raw << canyon::io::vio_csv_header() << '\n';
       } else if (ends_with(topic, "timesync")) {
         raw << "t_ns,gps_week,gps_tow_s\n";
       }
@@ -352,7 +326,14 @@ int run(int argc, char** argv) {
   if (kTool != "monitor" && ends_with(topic, "vio")) {
     auto r = pl::VioPoseReader::create(**participant, topic, "vio_reader", [&](canyon::msg::VioPose&& m) {
       if (kTool == "echo") return text_sample(pl::describe(m));
-      text_sample(vio_csv_row(m));
+      auto pose = pl::from_msg(m);
+      if (!pose) {
+        const std::lock_guard lock(mutex);
+        ++bad;
+        if (error.empty()) error = pose.error().to_string();
+        return;
+      }
+      text_sample(canyon::io::vio_csv_row(*pose));
     });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     vio_reader = std::move(*r);

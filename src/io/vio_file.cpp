@@ -5,6 +5,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <string_view>
 
 #include <Eigen/Cholesky>
@@ -16,6 +17,7 @@ namespace canyon::io {
 namespace {
 
 constexpr int kPoseFields = 8;
+constexpr std::array<std::string_view, kPoseFields> kNames = {"t_ns", "px", "py", "pz", "qx", "qy", "qz", "qw"};
 constexpr int kCovarianceFields = 21;
 constexpr int kCrossFields = 36;
 constexpr std::size_t kMaxWarningsPerKind = 5;
@@ -83,6 +85,37 @@ Result<std::vector<double>> parse_numbers(const std::vector<std::string_view>& f
 
 }  // namespace
 
+std::string vio_csv_header() {
+  std::string header;
+  for (int i = 0; i < kPoseFields; ++i)
+    header += std::string(i > 0 ? "," : "") + std::string(kNames[static_cast<std::size_t>(i)]);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = r; c < 6; ++c) header += ",cov_" + std::to_string(r) + "_" + std::to_string(c);
+  }
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) header += ",xcov_" + std::to_string(r) + "_" + std::to_string(c);
+  }
+  return header;
+}
+
+std::string vio_csv_row(const VioRecord& record) {
+  std::string row = std::to_string(record.t_ns);
+  char value[32];
+  const auto add = [&](double v) {
+    std::snprintf(value, sizeof value, ",%.17g", v);
+    row += value;
+  };
+  const core::Pose& T = record.T_OI;
+  for (const double v : {T.p.x(), T.p.y(), T.p.z(), T.q.x(), T.q.y(), T.q.z(), T.q.w()}) add(v);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = r; c < 6; ++c) add(record.covariance(r, c));
+  }
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) add(record.cross_previous ? (*record.cross_previous)(r, c) : 0.0);
+  }
+  return row;
+}
+
 Result<VioFile> read_vio_csv(const std::string& path) {
   auto opened = TextReader::open(path);
   if (!opened) return opened.error();
@@ -90,8 +123,6 @@ Result<VioFile> read_vio_csv(const std::string& path) {
   const auto header_line = reader.next_line();
   if (!header_line) return Error{"empty VIO file (no header row)", path, 1};
   const std::vector<std::string_view> header = split_csv(*header_line);
-  static constexpr std::array<std::string_view, kPoseFields> kNames = {"t_ns", "px", "py", "pz",
-                                                                       "qx",   "qy", "qz", "qw"};
   const auto columns = static_cast<int>(header.size());
   bool header_ok =
       columns == kPoseFields + kCovarianceFields || columns == kPoseFields + kCovarianceFields + kCrossFields;

@@ -23,6 +23,7 @@
 #include "canyon/core/geodesy.hpp"
 #include "canyon/io/rinex_obs.hpp"
 #include "canyon/io/text_file_writer.hpp"
+#include "canyon/io/vio_file.hpp"
 #include "canyon/sim/simulator.hpp"
 
 namespace canyon::sim {
@@ -103,14 +104,7 @@ Status write_city(const Simulation& sim, const std::string& path) {
 Status write_vio(const VioRun& vio, const std::string& path) {
   auto file = io::TextFileWriter::create(path, "VIO file");
   if (!file) return file.error();
-  std::string header = "t_ns,px,py,pz,qx,qy,qz,qw";
-  for (int r = 0; r < 6; ++r) {
-    for (int c = r; c < 6; ++c) header += format(",cov_%d_%d", r, c);
-  }
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) header += format(",xcov_%d_%d", r, c);
-  }
-  if (Status s = file->write_line(header); !s) return s;
+  if (Status s = file->write_line(io::vio_csv_header()); !s) return s;
   std::string line;
   for (const VioSample& v : vio.poses) {
     const Eigen::Quaterniond q = v.T_OI.q.normalized();

@@ -63,6 +63,11 @@ struct TimeSyncFile {
 };
 
 Result<VioFile> read_vio_csv(const std::string& path);
+/// vio.csv's header row, with the 36 cross-covariance columns.
+[[nodiscard]] std::string vio_csv_header();
+/// A vio.csv row of `record`, every value with 17 significant digits (read back exactly); an absent
+/// cross-covariance is written as zeros, which the reader takes the same way.
+[[nodiscard]] std::string vio_csv_row(const VioRecord& record);
 Result<TimeSyncFile> read_timesync_csv(const std::string& path);
 
 }  // namespace canyon::io
