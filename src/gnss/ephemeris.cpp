@@ -12,7 +12,10 @@
 #include "canyon/gnss/ephemeris.hpp"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <limits>
 
 #include "canyon/core/constants.hpp"
 
@@ -163,6 +166,29 @@ double band_frequency_hz(Constellation system, char band) {
 
 namespace {
 
+std::uint64_t next_selection_stamp() {
+  static std::atomic<std::uint64_t> counter{0};
+  return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+
+/// A satellite's last Kepler selection on this thread, reused while the query time t stays inside the open interval
+/// t_ref + (lo_s, hi_s) in which the selection cannot change. A selection is asked for three or four times per
+/// satellite and epoch (transmission time, state, group delay; rover and base) and changes every few minutes at most.
+struct KeplerSelectionMemo {
+  std::uint64_t stamp = 0;  // the store's selection_stamp_ when made; 0: empty
+  core::GpsTime t_ref;
+  double lo_s = 0.0;
+  double hi_s = 0.0;
+  int index = -1;  // into the store's nav().kepler, -1: none usable
+};
+
+/// Margin kept from the ends of a memo's interval, where the rounding of time differences could decide.
+constexpr double kSelectionMemoMarginS = 1e-6;
+
+}  // namespace
+
+namespace {
+
 /// Health as it concerns canyon's signals. QZSS LNAV's health word has the L1C/B (formerly LEX) signal in its least
 /// significant bit (IS-QZSS-PNT), set on satellites that do not transmit it: it says nothing about L1 C/A, L2C or
 /// L5, so it is ignored.
@@ -174,7 +200,7 @@ bool kepler_healthy(const core::KeplerEphemeris& e) {
 }  // namespace
 
 EphemerisStore::EphemerisStore(core::NavigationData nav, EphemerisOptions options)
-    : nav_(std::move(nav)), options_(options) {
+    : nav_(std::move(nav)), options_(options), selection_stamp_(next_selection_stamp()) {
   kepler_by_sat_.resize(core::kMaxSatellites);
   glonass_by_sat_.resize(core::kMaxSatellites);
   for (int i = 0; i < static_cast<int>(nav_.kepler.size()); ++i) index_kepler(i);
@@ -213,6 +239,7 @@ int EphemerisStore::add(const core::NavigationData& fresh) {
     index_glonass(static_cast<int>(nav_.glonass.size()) - 1);
     ++added;
   }
+  if (added > 0) selection_stamp_ = next_selection_stamp();
   if (!nav_.gps_klobuchar) nav_.gps_klobuchar = fresh.gps_klobuchar;
   if (!nav_.bds_klobuchar) nav_.bds_klobuchar = fresh.bds_klobuchar;
   return added;
@@ -220,6 +247,17 @@ int EphemerisStore::add(const core::NavigationData& fresh) {
 
 const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat, core::GpsTime t) const {
   if (!sat.valid() || sat.system == Constellation::Glonass) return nullptr;
+  thread_local std::array<KeplerSelectionMemo, core::kMaxSatellites> memos;
+  KeplerSelectionMemo& memo = memos[sat.index()];
+  if (memo.stamp != selection_stamp_ || !(t - memo.t_ref > memo.lo_s && t - memo.t_ref < memo.hi_s)) {
+    const int index = scan_kepler(sat, t);
+    const auto [lo_s, hi_s] = kepler_selection_interval(sat, t, index);
+    memo = {selection_stamp_, t, lo_s + kSelectionMemoMarginS, hi_s - kSelectionMemoMarginS, index};
+  }
+  return memo.index >= 0 ? &nav_.kepler[static_cast<std::size_t>(memo.index)] : nullptr;
+}
+
+int EphemerisStore::scan_kepler(core::SatelliteId sat, core::GpsTime t) const {
   const bool galileo = sat.system == Constellation::Galileo;
   const KeplerCandidate* best = nullptr;
   double best_age_s = 0.0;
@@ -242,7 +280,33 @@ const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat
     best = &c;
     best_age_s = age_s;
   }
-  return best != nullptr ? &nav_.kepler[static_cast<std::size_t>(best->index)] : nullptr;
+  return best != nullptr ? best->index : -1;
+}
+
+/// The scan's outcome is a function of which candidates are eligible and of how each compares with the chosen one.
+/// Eligibility changes only where t crosses a candidate's toe +- its maximum age (Galileo: also its toe); the
+/// comparison of two records of different toes only where their ages are equal, at the midpoint of the toes (the
+/// I/NAV preference and the tie on equal toes do not depend on t). So the outcome is constant between the nearest
+/// such times on either side of t; the interval is empty when t is one of them.
+std::pair<double, double> EphemerisStore::kepler_selection_interval(core::SatelliteId sat, core::GpsTime t,
+                                                                    int index) const {
+  const bool galileo = sat.system == Constellation::Galileo;
+  double lo_s = -std::numeric_limits<double>::infinity();
+  double hi_s = std::numeric_limits<double>::infinity();
+  const auto limit = [&](double offset_s) {
+    if (offset_s >= 0.0) hi_s = std::min(hi_s, offset_s);
+    if (offset_s <= 0.0) lo_s = std::max(lo_s, offset_s);
+  };
+  const bool chosen = index >= 0;
+  const double chosen_toe_s = chosen ? nav_.kepler[static_cast<std::size_t>(index)].toe - t : 0.0;
+  for (const KeplerCandidate& c : kepler_by_sat_[sat.index()]) {
+    const double toe_s = c.toe - t;
+    if (galileo) limit(toe_s);
+    limit(toe_s - c.max_age_s);
+    limit(toe_s + c.max_age_s);
+    if (chosen && toe_s != chosen_toe_s) limit(0.5 * (toe_s + chosen_toe_s));
+  }
+  return {lo_s, hi_s};
 }
 
 const core::GlonassEphemeris* EphemerisStore::select_glonass(core::SatelliteId sat, core::GpsTime t) const {

@@ -4,7 +4,10 @@
 
 #include "canyon/gnss/ephemeris.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -205,6 +208,100 @@ TEST(Ephemeris, SelectionRules) {
   EXPECT_EQ(gal.select_kepler(inav.sat, inav.toe + 601.0)->iode, 3);
   const EphemerisStore fnav_only = store_of({fnav});
   EXPECT_EQ(fnav_only.select_kepler(inav.sat, inav.toe + 300.0)->iode, 2);
+}
+
+// The selection rules of the file comment, record by record, without any memo: the reference for the store.
+const core::KeplerEphemeris* reference_selection(const std::vector<core::KeplerEphemeris>& records,
+                                                 core::SatelliteId sat, core::GpsTime t, double max_age_s) {
+  const bool galileo = sat.system == Constellation::Galileo;
+  const auto inav = [](const core::KeplerEphemeris& e) { return (e.data_source & 0x201) != 0; };
+  const core::KeplerEphemeris* best = nullptr;
+  for (const core::KeplerEphemeris& e : records) {
+    const double age_s = std::abs(t - e.toe);
+    const double limit_s = std::max(max_age_s, e.fit_interval_h * 3600.0 / 2.0);
+    if (e.sat != sat || e.health != 0 || age_s > limit_s || (galileo && !(e.toe < t))) continue;
+    if (best != nullptr) {
+      const double best_age_s = std::abs(t - best->toe);
+      if (galileo && inav(*best) != inav(e)) {
+        if (!inav(e)) continue;
+      } else if (age_s > best_age_s || (age_s == best_age_s && e.transmission_time < best->transmission_time)) {
+        continue;
+      }
+    }
+    best = &e;
+  }
+  return best;
+}
+
+// select_kepler() remembers each satellite's last selection while the query time cannot change it: swept forward,
+// backward and at random over two days -- across every toe, toe +- maximum age and midpoint between toes, and a
+// microsecond either side of each -- it answers as the rules do record by record.
+TEST(Ephemeris, RememberedSelectionEqualsTheRules) {
+  std::vector<core::KeplerEphemeris> records;
+  const core::GpsTime t0{2320, 100000.0};
+  for (int k = 0; k < 14; ++k) {  // GPS every 2 h, one of them sent twice, one unhealthy, one with a long fit
+    core::KeplerEphemeris e = gps_g05();
+    e.toe = e.toc = t0 + 7200.0 * k;
+    e.iode = k;
+    e.transmission_time = e.toe - 60.0;
+    e.health = k == 5 ? 1 : 0;
+    e.fit_interval_h = k == 9 ? 12.0 : 4.0;
+    records.push_back(e);
+    if (k == 3) {
+      e.iode = 100 + k;
+      e.transmission_time = e.toe - 30.0;
+      records.push_back(e);
+    }
+  }
+  for (int k = 0; k < 60; ++k) {  // Galileo I/NAV every 10 min, F/NAV in between, a gap of two hours
+    if (k >= 20 && k < 32) continue;
+    core::KeplerEphemeris e = gps_g05();
+    e.sat = {Constellation::Galileo, 4};
+    e.toe = e.toc = t0 + 600.0 * k + (k % 2 == 0 ? 0.0 : 300.0);
+    e.data_source = k % 3 == 0 ? 258 : 517;
+    e.iode = 200 + k;
+    e.transmission_time = e.toe - 10.0;
+    records.push_back(e);
+  }
+  const EphemerisStore store = store_of(records);
+  const double max_age_s = EphemerisOptions{}.max_age_kepler_s;
+
+  std::vector<core::GpsTime> times;
+  for (double dt_s = -20000.0; dt_s < 150000.0; dt_s += 97.3) times.push_back(t0 + dt_s);
+  for (const core::KeplerEphemeris& e : records) {
+    const double limit_s = std::max(max_age_s, e.fit_interval_h * 1800.0);
+    for (const core::KeplerEphemeris& f : records) {
+      if (f.sat != e.sat) continue;
+      for (const double dt_s : {-1e-6, 0.0, 1e-6}) times.push_back(e.toe + (0.5 * (f.toe - e.toe) + dt_s));
+    }
+    for (const double edge_s : {-limit_s, 0.0, limit_s}) {
+      for (const double dt_s : {-1e-6, 0.0, 1e-6}) times.push_back(e.toe + (edge_s + dt_s));
+    }
+  }
+  std::sort(times.begin(), times.end());
+  std::vector<core::GpsTime> order = times;
+  std::reverse(order.begin(), order.end());
+  order.insert(order.end(), times.begin(), times.end());
+  std::vector<core::GpsTime> shuffled = times;
+  std::mt19937 rng(7);
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  order.insert(order.end(), shuffled.begin(), shuffled.end());
+
+  int mismatches = 0;
+  for (const core::GpsTime& t : order) {
+    for (const core::SatelliteId sat : {records.front().sat, records.back().sat}) {
+      const core::KeplerEphemeris* expected = reference_selection(records, sat, t, max_age_s);
+      const core::KeplerEphemeris* got = store.select_kepler(sat, t);
+      const int expected_iode = expected != nullptr ? expected->iode : -1;
+      const int got_iode = got != nullptr ? got->iode : -1;
+      if (expected_iode != got_iode && ++mismatches <= 5) {
+        ADD_FAILURE() << sat.to_string() << " at week " << t.week << " tow " << t.tow_s << ": selected " << got_iode
+                      << ", the rules select " << expected_iode;
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(order.size(), 3000u);
 }
 
 // Ephemerides that arrive while running (a receiver's SFRBX, a base's RTCM) are added unless the store holds the

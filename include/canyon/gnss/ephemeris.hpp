@@ -15,7 +15,9 @@
 // ephemeris_reference_test.cpp); a Galileo toe marks the start of a record's use, so a future toe is a record not
 // broadcast yet.
 
+#include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -89,6 +91,11 @@ class EphemerisStore {
  private:
   void index_kepler(int i);
   void index_glonass(int i);
+  /// The scan behind select_kepler(): index into nav_.kepler of the record to use, -1 if none.
+  [[nodiscard]] int scan_kepler(core::SatelliteId sat, core::GpsTime t) const;
+  /// Open interval (lo, hi) of offsets d (s) such that scan_kepler(sat, t + d) picks `index` too (see the .cpp).
+  [[nodiscard]] std::pair<double, double> kepler_selection_interval(core::SatelliteId sat, core::GpsTime t,
+                                                                    int index) const;
 
   /// What selection reads of a usable (healthy, or use_unhealthy) Kepler record, kept contiguous per satellite so
   /// that a selection, done three times per satellite state, walks a short array instead of the records.
@@ -105,6 +112,9 @@ class EphemerisStore {
   // Per satellite (by SatelliteId::index()), in file order: Kepler candidates, GLONASS record indices into nav_.
   std::vector<std::vector<KeplerCandidate>> kepler_by_sat_;
   std::vector<std::vector<int>> glonass_by_sat_;
+  // Identifies the candidate lists for the selection memo (select_kepler): a process-wide counter, renewed whenever
+  // add() changes them; a copy shares it with its original, as it has the same lists.
+  std::uint64_t selection_stamp_ = 0;
 };
 
 /// Geometric range (m) from a receiver at p_E_rcv to a satellite at p_E_sat (ECEF at transmission time), with the
