@@ -7,6 +7,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <string_view>
 
 #include <Eigen/Cholesky>
@@ -43,6 +44,10 @@ struct Measurement {
 };
 
 constexpr double kAtmosphereRefreshM = 100.0;
+
+/// RAIM solves exactly only the exclusions whose first-order weighted residual sum is within this fraction of
+/// (1 + the least such sum): the others cannot be the best (see leave_one_out_sums()).
+constexpr double kExclusionScreenMargin = 0.05;
 
 /// Linearised system at one position.
 struct Linearised {
@@ -249,6 +254,24 @@ Result<Fix> iterate(const std::vector<Measurement>& ms, const std::vector<bool>&
   return Error{"no convergence in " + std::to_string(options.max_iterations) + " iterations"};
 }
 
+/// First-order weighted residual sum of the solution without row r, for every row: at the converged solution,
+/// least squares' deletion formula WSSR_r = WSSR - w_r v_r^2 / (1 - w_r h_r^T Q h_r). Leaving out a satellite moves
+/// the solution by metres at most, where the ranges' curvature and the elevation weights change the sum by far less
+/// than kExclusionScreenMargin. -inf where the row is the last of its clock (leverage 1: the clock leaves with it,
+/// which the formula does not describe), so that exclusion is always solved.
+std::vector<double> leave_one_out_sums(const Fix& fix) {
+  const Linearised& lin = fix.lin;
+  std::vector<double> sums(lin.rows.size());
+  for (Eigen::Index r = 0; r < lin.H.rows(); ++r) {
+    const double w = 1.0 / lin.variance[r];
+    const double leverage = w * lin.H.row(r).dot(fix.Q * lin.H.row(r).transpose());
+    sums[static_cast<std::size_t>(r)] = leverage < 1.0 - 1e-9
+                                            ? fix.weighted_sum - w * lin.v[r] * lin.v[r] / (1.0 - leverage)
+                                            : -std::numeric_limits<double>::infinity();
+  }
+  return sums;
+}
+
 bool passes_chi_square(const Fix& fix) {
   const int dof = static_cast<int>(fix.lin.v.size()) - static_cast<int>(fix.lin.H.cols());
   return dof <= 0 || fix.weighted_sum < chi_square_999(dof);
@@ -336,10 +359,20 @@ Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore&
 
   std::vector<SatelliteId> excluded_by_raim;
   if (options.raim_fde && !passes_chi_square(*fix) && fix->lin.v.size() >= fix->lin.H.cols() + 2) {
-    // Try every single exclusion from the converged position; keep the best that passes.
+    // Try the single exclusions that can give the least weighted sum, each solved from the converged position; keep
+    // the best that passes.
+    const std::vector<double> approximate = leave_one_out_sums(*fix);
+    double least = std::numeric_limits<double>::infinity();
+    for (const double sum : approximate) {
+      if (std::isfinite(sum)) least = std::min(least, sum);
+    }
     std::optional<Fix> best;
     std::size_t best_excluded = 0;
-    for (const int row_measurement : fix->lin.rows) {
+    for (std::size_t row = 0; row < fix->lin.rows.size(); ++row) {
+      if (std::isfinite(approximate[row]) && approximate[row] > least + kExclusionScreenMargin * (1.0 + least)) {
+        continue;  // cannot be the best
+      }
+      const int row_measurement = fix->lin.rows[row];
       std::vector<bool> trial = active;
       trial[static_cast<std::size_t>(row_measurement)] = false;
       auto candidate = iterate(ms, trial, fix->x, epoch.time, ephemerides, options);
