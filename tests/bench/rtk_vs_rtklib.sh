@@ -22,7 +22,8 @@
 # script says so, still prints RTKLIB's side, and exits 0.
 #
 # Usage: tests/bench/rtk_vs_rtklib.sh [BUILD_DIR] [RUNS]     (defaults: build, 5 timed runs of each program)
-# Environment: CANYON_SHARED_DATA_DIR (default ../shared/data), KEEP=1 keeps the temp folder and prints its path.
+# Environment: CANYON_SHARED_DATA_DIR (default ../shared/data), KEEP=1 keeps the temp folder and prints its path,
+# ONLY=REGEX runs only the rows whose dataset name matches (e.g. ONLY=cssrlib-kinematic for the speed target).
 # Exit status: 0 done (also when canyon's rtk mode is not available), 2 missing build or tools.
 set -euo pipefail
 
@@ -191,6 +192,7 @@ row() { printf '%-27s %-13s %8s %8s %9s %9s %6s %10s %10s %10s %7s\n' "$@"; }
 row dataset "AR mode" "c fix%" "R fix%" "c RMSE m" "R RMSE m" "c wrng" "max dfix m" "canyon ms" "RTKLIB ms" speedup
 for entry in "${runs_table[@]}"; do
   IFS='|' read -r name conf_name rover base truth navs <<<"$entry"
+  [[ -z ${ONLY:-} || $name =~ $ONLY ]] || continue
   IFS='|' read -r -a nav_files <<<"$navs"
   dir=$data/$(dataset_dir "$name")
   conf=$dir/rtklib/$conf_name
