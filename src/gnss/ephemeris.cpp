@@ -136,20 +136,43 @@ Eigen::Matrix<double, 6, 1> glonass_derivative(const Eigen::Matrix<double, 6, 1>
   return dx;
 }
 
-Eigen::Matrix<double, 6, 1> glonass_integrate(const core::GlonassEphemeris& eph, double dt_s) {
-  Eigen::Matrix<double, 6, 1> x;
-  x << eph.p_E_m, eph.v_E_mps;
-  double remaining_s = dt_s;
-  while (std::abs(remaining_s) > 1e-9) {
-    const double h = std::abs(remaining_s) < kGloStepS ? remaining_s : std::copysign(kGloStepS, remaining_s);
-    const auto k1 = glonass_derivative(x, eph.a_E_mps2);
-    const auto k2 = glonass_derivative(x + 0.5 * h * k1, eph.a_E_mps2);
-    const auto k3 = glonass_derivative(x + 0.5 * h * k2, eph.a_E_mps2);
-    const auto k4 = glonass_derivative(x + h * k3, eph.a_E_mps2);
-    x += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-    remaining_s -= h;
+/// The state after whole integration steps from a record's toe, kept per satellite and thread: a record is
+/// integrated over up to 15 minutes (15 steps of 4 derivatives) for every state, while consecutive calls share all
+/// but the last, partial step. Identified by the record's contents, so a hit is the same arithmetic by construction.
+struct GlonassSteps {
+  Eigen::Matrix<double, 9, 1> record = Eigen::Matrix<double, 9, 1>::Constant(std::numeric_limits<double>::quiet_NaN());
+  double direction = 0.0;  // +1 forward, -1 backward from toe
+  int steps = 0;           // whole steps taken
+  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
+};
+
+Eigen::Matrix<double, 6, 1> rk4_step(const Eigen::Matrix<double, 6, 1>& x, double h, const Eigen::Vector3d& a_ls) {
+  const auto k1 = glonass_derivative(x, a_ls);
+  const auto k2 = glonass_derivative(x + 0.5 * h * k1, a_ls);
+  const auto k3 = glonass_derivative(x + 0.5 * h * k2, a_ls);
+  const auto k4 = glonass_derivative(x + h * k3, a_ls);
+  return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+}
+
+/// Runge-Kutta 4 from the record's toe over dt_s: whole steps of kGloStepS, then the remainder (none below a
+/// nanosecond). The whole steps already taken for the same record and direction on this thread are reused (`cache`):
+/// dt_s - k kGloStepS is exact, so the result is that of integrating from the toe every time.
+Eigen::Matrix<double, 6, 1> glonass_integrate(const core::GlonassEphemeris& eph, double dt_s, GlonassSteps& cache) {
+  Eigen::Matrix<double, 9, 1> record;
+  record << eph.p_E_m, eph.v_E_mps, eph.a_E_mps2;
+  const double direction = dt_s < 0.0 ? -1.0 : 1.0;
+  auto whole_steps = static_cast<int>(std::floor(std::abs(dt_s) / kGloStepS));
+  if (std::abs(dt_s) - kGloStepS * whole_steps < 0.0) --whole_steps;  // the division rounded up to a whole number
+  if (std::abs(dt_s) - kGloStepS * whole_steps >= kGloStepS) ++whole_steps;
+  if (!(cache.record == record) || cache.direction != direction || cache.steps > whole_steps) {
+    cache.record = record;
+    cache.direction = direction;
+    cache.steps = 0;
+    cache.x << eph.p_E_m, eph.v_E_mps;
   }
-  return x;
+  for (; cache.steps < whole_steps; ++cache.steps) cache.x = rk4_step(cache.x, direction * kGloStepS, eph.a_E_mps2);
+  const double remaining_s = dt_s - direction * kGloStepS * whole_steps;
+  return std::abs(remaining_s) > 1e-9 ? rk4_step(cache.x, remaining_s, eph.a_E_mps2) : cache.x;
 }
 
 /// Galileo I/NAV record (data source bit 0 E1-B or bit 9 clock for E5b,E1).
@@ -333,7 +356,8 @@ std::optional<SatelliteState> EphemerisStore::state(core::SatelliteId sat, core:
     const core::GlonassEphemeris* g = select_glonass(sat, t_tx);
     if (g == nullptr) return std::nullopt;
     const double dt_s = t_tx - g->toe;
-    const Eigen::Matrix<double, 6, 1> x = glonass_integrate(*g, dt_s);
+    thread_local std::array<GlonassSteps, core::kMaxSatellites> steps;
+    const Eigen::Matrix<double, 6, 1> x = glonass_integrate(*g, dt_s, steps[sat.index()]);
     s.p_E_m = x.head<3>();
     s.v_E_mps = x.tail<3>();
     s.clock_bias_s = g->tau_n_s + g->gamma_n * dt_s;

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -157,6 +159,35 @@ TEST(Ephemeris, GlonassForwardAndBackAgree) {
   // Clock: RINEX stores -tau_n; clock = -tau_n + gamma_n (t - tb).
   EXPECT_DOUBLE_EQ(forward->clock_bias_s, g.tau_n_s + g.gamma_n * dt_s);
   EXPECT_EQ(forward->glonass_channel, 1);
+}
+
+// GLONASS states reuse the whole integration steps of the previous call for the same record (per thread). Queried in a
+// scrambled order -- forward and backward of toe, on and beside whole steps, one record then another then the first
+// again -- every state equals, bit for bit, the one a fresh thread computes by integrating from the toe.
+TEST(Ephemeris, GlonassStatesDoNotDependOnEarlierQueries) {
+  const core::GlonassEphemeris a = glonass_r01();
+  core::GlonassEphemeris b = a;
+  b.toe = a.toe + 1800.0;
+  b.p_E_m += Eigen::Vector3d(1.0e3, -2.0e3, 0.5e3);
+  const EphemerisStore early = store_of({}, {a});
+  const EphemerisStore late = store_of({}, {b});
+  std::vector<double> offsets_s = {0.0,  1e-10, 59.999, 60.0,    60.0 + 1e-10, 61.5,  119.9, 120.0, 600.0, 900.0,
+                                   -0.5, -60.0, -61.0,  -600.25, 301.0,        302.0, 0.2,   0.4,   898.7, 240.0};
+  std::mt19937 rng(11);
+  std::shuffle(offsets_s.begin(), offsets_s.end(), rng);
+  for (const auto* store : {&early, &late, &early}) {  // records in turn: the steps are kept for one at a time
+    for (const double offset_s : offsets_s) {
+      const core::GpsTime t = store->nav().glonass.front().toe + offset_s;
+      const auto here = store->state(a.sat, t);
+      std::optional<SatelliteState> fresh;
+      std::thread([&] { fresh = store->state(a.sat, t); }).join();
+      ASSERT_TRUE(here && fresh) << offset_s;
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_EQ(here->p_E_m[i], fresh->p_E_m[i]) << "offset " << offset_s << " s, axis " << i;
+        EXPECT_EQ(here->v_E_mps[i], fresh->v_E_mps[i]) << "offset " << offset_s << " s, axis " << i;
+      }
+    }
+  }
 }
 
 TEST(Ephemeris, KeplerClockIncludesRelativity) {
