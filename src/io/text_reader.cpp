@@ -214,72 +214,23 @@ constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8
                              1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 constexpr std::uint64_t kMaxExactMantissa = std::uint64_t{1} << 53;
 
-/// Exact fast path for the numbers RINEX is made of: [+-]digits[.digits][(E|D)[+-]digits]. When the digits form an
-/// integer below 2^53 and the decimal scale is a power of ten that double holds exactly (<= 1e22), the value is one
-/// IEEE division or multiplication of exact operands, hence correctly rounded: the same result as from_chars.
-/// nullopt when the text is not of that form or not in that range (the caller falls back to from_chars).
-std::optional<double> parse_simple_decimal(std::string_view text) {
-  std::size_t i = 0;
-  const bool negative = text[0] == '-';
-  if (text[0] == '-' || text[0] == '+') ++i;
-  std::uint64_t mantissa = 0;
-  int fraction_digits = 0;
-  int digits = 0;
-  bool dot = false;
-  for (; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c >= '0' && c <= '9') {
-      if (++digits > 18) return std::nullopt;
-      mantissa = mantissa * 10 + static_cast<std::uint64_t>(c - '0');
-      if (dot) ++fraction_digits;
-    } else if (c == '.' && !dot) {
-      dot = true;
-    } else {
-      break;
-    }
-  }
-  if (digits == 0 || mantissa >= kMaxExactMantissa) return std::nullopt;
-  int exponent = 0;
-  if (i < text.size()) {
-    if (text[i] != 'E' && text[i] != 'e' && text[i] != 'D' && text[i] != 'd') return std::nullopt;
-    ++i;
-    bool exponent_negative = false;
-    if (i < text.size() && (text[i] == '-' || text[i] == '+')) exponent_negative = text[i++] == '-';
-    if (i == text.size() || text.size() - i > 3) return std::nullopt;
-    for (; i < text.size(); ++i) {
-      if (text[i] < '0' || text[i] > '9') return std::nullopt;
-      exponent = exponent * 10 + (text[i] - '0');
-    }
-    if (exponent_negative) exponent = -exponent;
-  }
-  const int scale = exponent - fraction_digits;
-  double value = static_cast<double>(mantissa);
-  if (scale < 0) {
-    if (-scale > 22) return std::nullopt;
-    value /= kPow10[-scale];
-  } else if (scale > 0) {
-    // m 10^scale is an integer; if the rounded product is below 2^53 the exact one is too, so it is exact.
-    if (scale > 22) return std::nullopt;
-    value *= kPow10[scale];
-    if (value >= static_cast<double>(kMaxExactMantissa)) return std::nullopt;
-  }
-  return negative ? -value : value;
-}
-
-/// One pass over the commonest form, [spaces][+-]digits[.digits][spaces] with at most 15 digits (every RINEX
-/// observation value): Blank, a Value computed exactly as parse_simple_decimal() does (an integer mantissa below
-/// 2^53 divided by a power of ten, correctly rounded), or Other (any other form, for the general path).
-struct PlainDecimal {
+/// A field read in one pass when it has the form of every RINEX and CSV number canyon meets,
+/// [spaces][+-]digits[.digits][(E|e|D|d)[+-]d[d[d]]][spaces]: Blank, an exact Value, or Other (any other form or
+/// range, for from_chars). When the digits form an integer below 2^53 and the decimal scale is a power of ten that a
+/// double holds exactly (<= 1e22), the value is one IEEE division or multiplication of exact operands, hence
+/// correctly rounded: the result from_chars gives.
+struct FastDecimal {
   enum class Kind { Blank, Value, Other };
   Kind kind = Kind::Other;
   double value = 0.0;
 };
 
-PlainDecimal parse_plain_decimal(std::string_view text) {
+FastDecimal parse_fast_decimal(std::string_view text) {
+  constexpr FastDecimal kOther{};
   const char* p = text.data();
   const char* const end = p + text.size();
   while (p != end && *p == ' ') ++p;
-  if (p == end) return {PlainDecimal::Kind::Blank, 0.0};
+  if (p == end) return {FastDecimal::Kind::Blank, 0.0};
   const bool negative = *p == '-';
   if (*p == '-' || *p == '+') ++p;
   std::uint64_t mantissa = 0;
@@ -289,8 +240,8 @@ PlainDecimal parse_plain_decimal(std::string_view text) {
   for (; p != end; ++p) {
     const char c = *p;
     if (c >= '0' && c <= '9') {
+      if (++digits > 18) return kOther;  // the mantissa could overflow; beyond the exact range anyway
       mantissa = mantissa * 10 + static_cast<std::uint64_t>(c - '0');
-      ++digits;
       fraction_digits += dot ? 1 : 0;
     } else if (c == '.' && !dot) {
       dot = true;
@@ -298,23 +249,43 @@ PlainDecimal parse_plain_decimal(std::string_view text) {
       break;
     }
   }
+  int exponent = 0;
+  if (p != end && (*p == 'E' || *p == 'e' || *p == 'D' || *p == 'd')) {
+    ++p;
+    const bool exponent_negative = p != end && *p == '-';
+    if (p != end && (*p == '-' || *p == '+')) ++p;
+    int exponent_digits = 0;
+    for (; p != end && *p >= '0' && *p <= '9'; ++p) {
+      if (++exponent_digits > 3) return kOther;
+      exponent = exponent * 10 + (*p - '0');
+    }
+    if (exponent_digits == 0) return kOther;
+    if (exponent_negative) exponent = -exponent;
+  }
   while (p != end && *p == ' ') ++p;
-  constexpr int kMaxPlainDigits = 15;  // mantissa < 10^15 < 2^53: exact
-  if (p != end || digits == 0 || digits > kMaxPlainDigits) return {};
+  if (p != end || digits == 0 || mantissa >= kMaxExactMantissa) return kOther;
+  const int scale = exponent - fraction_digits;
   double value = static_cast<double>(mantissa);
-  if (fraction_digits > 0) value /= kPow10[fraction_digits];
-  return {PlainDecimal::Kind::Value, negative ? -value : value};
+  if (scale < 0) {
+    if (-scale > 22) return kOther;
+    value /= kPow10[-scale];
+  } else if (scale > 0) {
+    // m 10^scale is an integer; if the rounded product is below 2^53 the exact one is too, so it is exact.
+    if (scale > 22) return kOther;
+    value *= kPow10[scale];
+    if (value >= static_cast<double>(kMaxExactMantissa)) return kOther;
+  }
+  return {FastDecimal::Kind::Value, negative ? -value : value};
 }
 
 }  // namespace
 
 std::optional<double> parse_double(std::string_view field, std::optional<double> blank_value) {
-  const PlainDecimal plain = parse_plain_decimal(field);
-  if (plain.kind == PlainDecimal::Kind::Value) return plain.value;
-  if (plain.kind == PlainDecimal::Kind::Blank) return blank_value;
+  const FastDecimal fast = parse_fast_decimal(field);
+  if (fast.kind == FastDecimal::Kind::Value) return fast.value;
+  if (fast.kind == FastDecimal::Kind::Blank) return blank_value;
   field = trim(field);
   if (field.empty()) return blank_value;
-  if (const auto fast = parse_simple_decimal(field)) return fast;
   char buffer[64] = {};
   if (field.size() >= sizeof buffer) return std::nullopt;
   std::size_t n = 0;

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -25,12 +26,13 @@ TEST(ParseDouble, FastPathEqualsStrtodBitForBit) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> magnitude(-12.0, 9.0);
   std::uniform_int_distribution<int> sign(0, 1);
-  const char* formats[] = {"%14.3f", "%19.12E", "%.12E", "%10.4f", "%g", "%.17g", "%8.1f"};
+  // RINEX observations and navigation records, .pos and CSV files (vio.csv: %.10e, %.12f), padded fields.
+  const char* formats[] = {"%14.3f", "%19.12E", "%.12E", "%10.4f", "%g", "%.17g", "%8.1f", "%.10e", "%.12f", " %.6f "};
   int checked = 0;
   for (int i = 0; i < 200000; ++i) {
     const double v = (sign(rng) ? -1.0 : 1.0) * std::pow(10.0, magnitude(rng));
     char buffer[64];
-    std::snprintf(buffer, sizeof buffer, formats[i % 7], v);
+    std::snprintf(buffer, sizeof buffer, formats[i % std::size(formats)], v);
     std::string text = buffer;
     if (i % 3 == 0) {  // Fortran exponent letter as in RINEX navigation files
       const auto e = text.find('E');
