@@ -208,10 +208,6 @@ struct KeplerSelectionMemo {
 /// Margin kept from the ends of a memo's interval, where the rounding of time differences could decide.
 constexpr double kSelectionMemoMarginS = 1e-6;
 
-}  // namespace
-
-namespace {
-
 /// Health as it concerns canyon's signals. QZSS LNAV's health word has the L1C/B (formerly LEX) signal in its least
 /// significant bit (IS-QZSS-PNT), set on satellites that do not transmit it: it says nothing about L1 C/A, L2C or
 /// L5, so it is ignored.
