@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "canyon/core/constants.hpp"
 
@@ -189,6 +190,15 @@ double band_frequency_hz(Constellation system, char band) {
 
 namespace {
 
+/// One T per satellite for the calling thread, made on the thread's first call: on the heap, so that the threads
+/// that never compute a satellite state (readers, DDS) do not carry it in their thread-local storage.
+template <typename T>
+std::array<T, core::kMaxSatellites>& per_thread() {
+  thread_local std::unique_ptr<std::array<T, core::kMaxSatellites>> entries;
+  if (!entries) entries = std::make_unique<std::array<T, core::kMaxSatellites>>();
+  return *entries;
+}
+
 std::uint64_t next_selection_stamp() {
   static std::atomic<std::uint64_t> counter{0};
   return counter.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -266,8 +276,7 @@ int EphemerisStore::add(const core::NavigationData& fresh) {
 
 const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat, core::GpsTime t) const {
   if (!sat.valid() || sat.system == Constellation::Glonass) return nullptr;
-  thread_local std::array<KeplerSelectionMemo, core::kMaxSatellites> memos;
-  KeplerSelectionMemo& memo = memos[sat.index()];
+  KeplerSelectionMemo& memo = per_thread<KeplerSelectionMemo>()[sat.index()];
   if (memo.stamp != selection_stamp_ || !(t - memo.t_ref > memo.lo_s && t - memo.t_ref < memo.hi_s)) {
     const int index = scan_kepler(sat, t);
     const auto [lo_s, hi_s] = kepler_selection_interval(sat, t, index);
@@ -352,8 +361,7 @@ std::optional<SatelliteState> EphemerisStore::state(core::SatelliteId sat, core:
     const core::GlonassEphemeris* g = select_glonass(sat, t_tx);
     if (g == nullptr) return std::nullopt;
     const double dt_s = t_tx - g->toe;
-    thread_local std::array<GlonassSteps, core::kMaxSatellites> steps;
-    const Eigen::Matrix<double, 6, 1> x = glonass_integrate(*g, dt_s, steps[sat.index()]);
+    const Eigen::Matrix<double, 6, 1> x = glonass_integrate(*g, dt_s, per_thread<GlonassSteps>()[sat.index()]);
     s.p_E_m = x.head<3>();
     s.v_E_mps = x.tail<3>();
     s.clock_bias_s = g->tau_n_s + g->gamma_n * dt_s;
