@@ -186,10 +186,6 @@ double band_frequency_hz(Constellation system, char band) {
   return f.value_or(0.0);
 }
 
-}  // namespace
-
-namespace {
-
 /// One T per satellite for the calling thread, made on the thread's first call: on the heap, so that the threads
 /// that never compute a satellite state (readers, DDS) do not carry it in their thread-local storage.
 template <typename T>
@@ -277,7 +273,8 @@ int EphemerisStore::add(const core::NavigationData& fresh) {
 const core::KeplerEphemeris* EphemerisStore::select_kepler(core::SatelliteId sat, core::GpsTime t) const {
   if (!sat.valid() || sat.system == Constellation::Glonass) return nullptr;
   KeplerSelectionMemo& memo = per_thread<KeplerSelectionMemo>()[sat.index()];
-  if (memo.stamp != selection_stamp_ || !(t - memo.t_ref > memo.lo_s && t - memo.t_ref < memo.hi_s)) {
+  const double since_ref_s = t - memo.t_ref;
+  if (memo.stamp != selection_stamp_ || !(since_ref_s > memo.lo_s && since_ref_s < memo.hi_s)) {
     const int index = scan_kepler(sat, t);
     const auto [lo_s, hi_s] = kepler_selection_interval(sat, t, index);
     memo = {selection_stamp_, t, lo_s + kSelectionMemoMarginS, hi_s - kSelectionMemoMarginS, index};

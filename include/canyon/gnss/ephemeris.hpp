@@ -47,7 +47,8 @@ struct EphemerisOptions {
   double max_age_glonass_s = 1800.0 + 60.0;
 };
 
-/// Owns the navigation data and answers satellite states. Thread-compatible (const methods are safe to share).
+/// Owns the navigation data and answers satellite states. Thread-compatible (const methods are safe to share): the
+/// memos that spare repeated work (each satellite's Kepler selection, GLONASS integration steps) are per thread.
 class EphemerisStore {
  public:
   explicit EphemerisStore(core::NavigationData nav, EphemerisOptions options = {});
