@@ -191,7 +191,7 @@ void EpochPipeline::run_stage(Stage stage, EpochItem& item) {
     case Stage::Ambiguity: estimator_.resolve(item); break;
   }
   item.exit_ns[i] = monotonic_ns();
-  if (observer_) observer_(stage, item);
+  if (observer_.taken) observer_.taken(stage, item);
 }
 
 Status EpochPipeline::run() {
@@ -208,7 +208,7 @@ void EpochPipeline::ingested(EpochItem& item, std::uint64_t seq, std::int64_t en
   if (item.arrival_ns == 0) item.arrival_ns = enter_ns;
   item.enter_ns[0] = item.arrival_ns;
   item.exit_ns[0] = monotonic_ns();
-  if (observer_) observer_(Stage::Ingest, item);
+  if (observer_.taken) observer_.taken(Stage::Ingest, item);
 }
 
 void EpochPipeline::add_navigation(const EpochItem& item) {
@@ -227,7 +227,9 @@ Status EpochPipeline::run_sequential() {
     ingested(item, seq, enter);
     for (std::size_t s = 1; s < kNumStages; ++s) run_stage(static_cast<Stage>(s), item);
     ++epochs_;
-    if (Status w = sink_(item); !w) return w;
+    Status w = sink_(item);
+    for (std::size_t s = 0; s < kNumStages; ++s) handed_on(static_cast<Stage>(s));
+    if (!w) return w;
   }
   estimator_.finish();
   return Ok{};
@@ -255,6 +257,7 @@ Status EpochPipeline::run_threaded() {
       auto item = std::make_unique<EpochItem>(std::move(**next));
       ingested(*item, seq, enter);
       push(0, std::move(item));
+      handed_on(Stage::Ingest);
     }
     push(0, nullptr);
   });
@@ -276,6 +279,7 @@ Status EpochPipeline::run_threaded() {
       }
       run_stage(stage, *item);
       push(in + 1, std::move(item));
+      handed_on(stage);
     }
     push(in + 1, nullptr);
   };
@@ -295,6 +299,7 @@ Status EpochPipeline::run_threaded() {
     if (!failed_.load()) {
       if (Status w = sink_(*item); !w) fail(w.error());
     }
+    handed_on(Stage::Ambiguity);
   }
   ingest.join();
   bridge.join();

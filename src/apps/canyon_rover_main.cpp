@@ -402,11 +402,22 @@ int run(int argc, char** argv) {
   app::EpochPipeline* pipeline_ptr = nullptr;
   pl::EpochContext context;
   context.rover_id = config->rover_id;
-  const auto observer = [&](app::Stage stage, const app::EpochItem& item) {
-    if (stage == app::Stage::TimeBridge && bridged_writer) {
-      auto m = pl::to_msg_bridged(item);
-      if (!bridged_writer->write(m)) ++refused;
-    }
+  // The solution is written as soon as the ambiguity stage has it. The stage outputs (canyon/bridged, /prior,
+  // /float, /alignment: every stage's output is still in the epoch then) and the timing are taken then too and written
+  // once the epoch has moved on (StageObserver): their DDS writes delay no epoch and, in the threaded pipeline, no
+  // other stage's thread (on two cores a write on the time bridge's thread held up the next stage's wake-up). The
+  // pending messages belong to the ambiguity stage's thread.
+  std::optional<canyon::msg::BridgedEpoch> bridged_pending;
+  std::optional<canyon::msg::Prior> prior_pending;
+  std::optional<canyon::msg::FloatSolution> float_pending;
+  std::optional<canyon::msg::Alignment> alignment_pending;
+  std::optional<canyon::msg::StageTiming> timing_pending;
+  const auto write = [&refused](auto& writer, auto& pending) {
+    if (pending && !writer->write(*pending)) ++refused;
+    pending.reset();
+  };
+  app::StageObserver observer;
+  observer.taken = [&](app::Stage stage, const app::EpochItem& item) {
     if (stage != app::Stage::Ambiguity) return;
     context.base_late = source.base_late();
     context.malformed_samples = pl::malformed_payloads();
@@ -425,20 +436,23 @@ int run(int argc, char** argv) {
       context.alignment_eigen_ratio = item.output->alignment->first_eigenvalue_ratio;
       context.lever_arm_m = item.output->alignment->t_IA_m;
     }
-    if (prior_writer) {
-      auto prior = pl::to_msg_prior(item);
-      if (!prior_writer->write(prior)) ++refused;
-      auto floating = pl::to_msg_float(item);
-      if (!float_writer->write(floating)) ++refused;
-    }
-    if (alignment_writer) {
-      auto alignment = pl::to_msg_alignment(item);
-      if (!alignment_writer->write(alignment)) ++refused;
-    }
     auto solution = pl::to_msg_solution(item, context);
     if (!(*solution_writer)->write(solution)) ++refused;
-    auto timing = pl::to_msg_timing(item, context);
-    if (!(*timing_writer)->write(timing)) ++refused;
+    timing_pending = pl::to_msg_timing(item, context);
+    if (prior_writer) {
+      prior_pending = pl::to_msg_prior(item);
+      float_pending = pl::to_msg_float(item);
+    }
+    if (bridged_writer) bridged_pending = pl::to_msg_bridged(item);
+    if (alignment_writer) alignment_pending = pl::to_msg_alignment(item);
+  };
+  observer.handed_on = [&](app::Stage stage) {
+    if (stage != app::Stage::Ambiguity) return;
+    write(*timing_writer, timing_pending);
+    write(bridged_writer, bridged_pending);
+    write(prior_writer, prior_pending);
+    write(float_writer, float_pending);
+    write(alignment_writer, alignment_pending);
   };
   app::EpochPipeline pipeline(source, feed, sink, config->pipeline, observer);
   pipeline_ptr = &pipeline;

@@ -3,15 +3,18 @@
 //    (shared data; skipped when absent) and fusion on a generated urban-severe scenario with VIO;
 //  - queues: a full queue blocks its producer (counted, nothing dropped, order kept); empty queues wait;
 //  - stop() with epochs in flight: every epoch ingested reaches the sink, run() returns cleanly;
-//  - a failing source or sink stops the pipeline with its error, without hanging.
+//  - a failing source or sink stops the pipeline with its error, without hanging;
+//  - the stage observer's two steps (taken, handed_on), per epoch, on each stage's thread.
 
 #include "canyon/app/epoch_pipeline.hpp"
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -272,6 +275,61 @@ TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
   ASSERT_TRUE(pipeline.run().ok());
   EXPECT_EQ(sunk, 20);
   for (const auto w : pipeline.stats().full_waits) EXPECT_EQ(w, 0U);
+}
+
+// The stage observer: per stage and epoch, taken() right after the stage (its exit stamped), then handed_on() on the
+// same thread before the stage takes its next epoch; the ambiguity stage's handed_on() comes after the epoch's sink.
+TEST(EpochPipeline, ObserverTakesThenHandsOnEachEpochOnItsStageThread) {
+  for (const auto& [name, options] : layouts()) {
+    constexpr int kEpochs = 50;
+    CountingSource source(kEpochs, std::chrono::microseconds(0));
+    RecordingEstimator estimator;
+    struct StageLog {
+      std::vector<char> events;  // 't' taken, 'h' handed on
+      std::vector<std::uint64_t> taken_seq;
+      std::set<std::thread::id> threads;
+      std::vector<int> sunk_when_handed_on;
+    };
+    std::array<StageLog, kNumStages> logs;  // each written by its stage's thread only
+    std::atomic<int> sunk{0};
+    StageObserver observer;
+    observer.taken = [&logs](Stage stage, const EpochItem& item) {
+      StageLog& log = logs[static_cast<std::size_t>(stage)];
+      EXPECT_GT(item.exit_ns[static_cast<std::size_t>(stage)], 0);
+      log.events.push_back('t');
+      log.taken_seq.push_back(item.seq);
+      log.threads.insert(std::this_thread::get_id());
+    };
+    observer.handed_on = [&logs, &sunk](Stage stage) {
+      StageLog& log = logs[static_cast<std::size_t>(stage)];
+      log.events.push_back('h');
+      log.threads.insert(std::this_thread::get_id());
+      log.sunk_when_handed_on.push_back(sunk.load());
+    };
+    EpochPipeline pipeline(
+        source, estimator,
+        [&sunk](const EpochItem&) -> Status {
+          sunk.fetch_add(1);
+          return Ok{};
+        },
+        options, observer);
+    ASSERT_TRUE(pipeline.run().ok()) << name;
+    ASSERT_EQ(sunk.load(), kEpochs) << name;
+    for (std::size_t s = 0; s < kNumStages; ++s) {
+      const StageLog& log = logs[s];
+      const char* stage = stage_name(static_cast<Stage>(s));
+      ASSERT_EQ(log.events.size(), 2U * kEpochs) << name << " " << stage;
+      for (std::size_t k = 0; k < log.events.size(); ++k) {
+        EXPECT_EQ(log.events[k], k % 2 == 0 ? 't' : 'h') << name << " " << stage << " event " << k;
+      }
+      for (std::size_t k = 0; k < log.taken_seq.size(); ++k) EXPECT_EQ(log.taken_seq[k], k) << name << " " << stage;
+      EXPECT_EQ(log.threads.size(), 1U) << name << " " << stage;
+    }
+    const StageLog& last = logs[static_cast<std::size_t>(Stage::Ambiguity)];
+    for (std::size_t k = 0; k < last.sunk_when_handed_on.size(); ++k) {
+      EXPECT_GE(last.sunk_when_handed_on[k], static_cast<int>(k) + 1) << name << ": handed on before its sink";
+    }
+  }
 }
 
 TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {

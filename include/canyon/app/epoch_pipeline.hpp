@@ -176,8 +176,17 @@ class FusionEstimator final : public EpochEstimator {
 
 /// Receives each epoch after its last stage (on the ambiguity stage's thread); an error stops the pipeline.
 using EpochSink = std::function<Status(const EpochItem&)>;
-/// Called on a stage's thread when it finished with an epoch (e.g. to publish the stage's output); must be quick.
-using StageObserver = std::function<void(Stage, const EpochItem&)>;
+/// What a stage's output means to the outside (the rover publishes it on DDS), in two steps, both on the stage's
+/// thread, each once per epoch and stage:
+///  - taken(stage, item): right after the stage, before the epoch moves on. It delays the epoch: keep it quick (take
+///    a copy of what a message needs), except for what must leave first (the rover writes the solution here).
+///  - handed_on(stage): once the epoch has moved on (threaded: queued for the next stage, or for the ambiguity stage
+///    after the sink; sequential: after the epoch's sink, stage by stage). The place for slow work such as DDS
+///    writes: it no longer delays this epoch, and in the threaded pipeline it overlaps the next stage.
+struct StageObserver {
+  std::function<void(Stage, const EpochItem&)> taken;
+  std::function<void(Stage)> handed_on;
+};
 
 struct PipelineOptions {
   bool threaded = false;            ///< six threads and queues; false: one thread, stage after stage
@@ -217,6 +226,9 @@ class EpochPipeline {
   /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
   void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
   void run_stage(Stage stage, EpochItem& item);
+  void handed_on(Stage stage) const {
+    if (observer_.handed_on) observer_.handed_on(stage);
+  }
   /// Waits until every epoch before `item` has left the last stage, then hands its ephemerides to the estimator.
   void add_navigation(const EpochItem& item);
   void fail(const Error& error);
