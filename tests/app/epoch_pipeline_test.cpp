@@ -171,7 +171,9 @@ class RecordingEstimator final : public EpochEstimator {
   void check(const EpochItem& item, std::uint64_t& next) {
     EXPECT_EQ(item.seq, next);
     ++next;
-    if (&next == &in_align_) EXPECT_EQ(busy_.exchange(true), false);
+    if (&next == &in_align_) {
+      EXPECT_EQ(busy_.exchange(true), false);
+    }
   }
   std::uint64_t in_align_ = 0, in_predict_ = 0;
   std::atomic<bool> busy_{false};
@@ -265,7 +267,9 @@ TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
         // Every stage stamped the epoch, in order, after its arrival.
         for (std::size_t s = 0; s < kNumStages; ++s) {
           EXPECT_LE(item.enter_ns[s], item.exit_ns[s]);
-          if (s > 0) EXPECT_LE(item.exit_ns[s - 1], item.enter_ns[s]);
+          if (s > 0) {
+            EXPECT_LE(item.exit_ns[s - 1], item.enter_ns[s]);
+          }
         }
         EXPECT_LE(item.arrival_ns, item.exit_ns[kNumStages - 1]);
         ++sunk;

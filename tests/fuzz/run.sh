@@ -3,7 +3,7 @@
 # gcc build) and runs each for SECONDS: fuzz_rtcm3 (RTCM 3 framing and every message decoder), fuzz_ubx (mixed
 # UBX / NMEA / RTCM 3 streams, RAWX, SFRBX navigation words, NAV-PVT, NAV-TIMEGPS), fuzz_ntrip (NTRIP requests and
 # responses, chunked coding, source table). A crash, a leak, a sanitizer report or a hang (10 s per input) fails the
-# run; the crashing input is left in WORK_DIR.
+# run; the crashing input is left in WORK_DIR. The three run at the same time.
 #
 # Usage: tests/fuzz/run.sh SECONDS [WORK_DIR]      (default WORK_DIR: <repo>/build/fuzz)
 # Exit status: 0 clean, 1 a fuzzer found a problem or the build failed, 77 clang++-14 / libFuzzer not installed.
@@ -90,14 +90,22 @@ if [[ -z "$(ls -A "${work}/corpus_ntrip")" ]]; then
   printf '1a;ext\r\n0123456789abcdef0123456789\r\n0\r\nX: y\r\n\r\n' > "${work}/corpus_ntrip/chunks"
 fi
 
-status=0
-summary=()
+# The fuzzers run side by side (on 2 cores, 3 of them share the cores: fewer executions each, a third of the time).
+pids=()
 for t in "${targets[@]}"; do
   name="${t#fuzz_}"
   echo "== ${t}: ${seconds} s"
+  (cd "${work}" && exec "./${t}" -max_total_time="${seconds}" -timeout=10 -max_len=8192 -rss_limit_mb=2048 \
+    -print_final_stats=1 "corpus_${name}" > "${work}/${t}.log" 2>&1) &
+  pids+=($!)
+done
+status=0
+summary=()
+for i in "${!targets[@]}"; do
+  t="${targets[$i]}"
+  name="${t#fuzz_}"
   log="${work}/${t}.log"
-  if (cd "${work}" && "./${t}" -max_total_time="${seconds}" -timeout=10 -max_len=8192 -rss_limit_mb=2048 \
-    -print_final_stats=1 "corpus_${name}" > "${log}" 2>&1); then
+  if wait "${pids[$i]}"; then
     result="no crash, leak or hang"
   else
     result="FAILED (see ${log} and ${work}/crash-*, leak-*, timeout-*)"
