@@ -1,5 +1,6 @@
-// canyon-record, canyon-echo and canyon-monitor (one source, CANYON_TOOL selects): consumers of the rover's and
-// the base's DDS topics. `canyon record|echo|monitor ...` runs them.
+// canyon-record, canyon-echo and canyon-monitor (one executable, canyon-monitor, with canyon-record and canyon-echo
+// links to it; the name it runs under selects the tool): consumers of the rover's and the base's DDS topics.
+// `canyon record|echo|monitor ...` runs them.
 //   record TOPIC --out FILE: canyon/solution to .pos (RTKLIB format), .nmea (GGA) or .csv (every sample, status 0
 //     too, with its sequence number and arrival time: the sequence accounting); canyon/rtcm to the raw
 //     RTCM 3 stream (replayable: canyon base input.kind rtcm3, canyon process base: FILE.rtcm3); canyon/timing and
@@ -38,15 +39,12 @@
 #include "canyon/dashboard/dashboard.hpp"
 #endif
 
-#ifndef CANYON_TOOL
-#define CANYON_TOOL "echo"
-#endif
-
 namespace {
 
 constexpr int kExitRuntime = 1;
 constexpr int kExitUsage = 2;
-const std::string kTool = CANYON_TOOL;
+// "record", "echo" or "monitor": set once in main from the name the executable runs under, before anything reads it.
+std::string g_tool;
 
 namespace pl = canyon::pipeline;
 namespace app = canyon::app;
@@ -68,12 +66,12 @@ class Recorder {
 };
 
 int fail(const std::string& message, int code) {
-  std::cerr << "canyon " << kTool << ": error: " << message << "\n";
+  std::cerr << "canyon " << g_tool << ": error: " << message << "\n";
   return code;
 }
 
 int run(int argc, char** argv) {
-  CLI::App cli{"canyon-" + kTool};
+  CLI::App cli{"canyon-" + g_tool};
   std::string topic;
   std::string out;
   int domain = 0;
@@ -82,14 +80,14 @@ int run(int argc, char** argv) {
   double duration_s = 0.0;
   bool json = false;
   double interval_s = 1.0;
-  bool until_gone = kTool != "echo";
+  bool until_gone = g_tool != "echo";
   std::string solution_topic = "canyon/solution";
   std::string timing_topic = "canyon/timing";
 #ifdef CANYON_WITH_DASHBOARD
   int http_port = -1;  // -1: no dashboard
   canyon::dashboard::ServerOptions dashboard_options;
 #endif
-  if (kTool != "monitor") {
+  if (g_tool != "monitor") {
     cli.add_option("topic", topic,
                    "canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior, "
                    "canyon/float, canyon/vio or canyon/timesync")
@@ -108,7 +106,7 @@ int run(int argc, char** argv) {
                    "Folder of the bundled dashboard page (default: build/web/dist)");
 #endif
   }
-  if (kTool == "record") {
+  if (g_tool == "record") {
     cli.add_option("--out", out, "Output file: .pos, .nmea or .csv (solutions), .rtcm3 (canyon/rtcm), .csv")
         ->required();
   }
@@ -123,7 +121,7 @@ int run(int argc, char** argv) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : kExitUsage;
   }
-  if (kTool != "monitor") {
+  if (g_tool != "monitor") {
     bool known = false;
     for (const char* suffix :
          {"solution", "timing", "rtcm", "bridged", "prior", "float", "alignment", "vio", "timesync"}) {
@@ -164,7 +162,7 @@ int run(int argc, char** argv) {
   std::optional<canyon::io::NmeaWriter> nmea;
   std::ofstream raw;
   const bool solutions = ends_with(topic, "solution");
-  if (kTool == "record") {
+  if (g_tool == "record") {
     if (solutions && ends_with(out, ".pos")) {
       auto p = canyon::io::PosWriter::create(out, {canyon::io::PosCoordinates::Llh,
                                                    canyon::io::PosTimeFormat::WeekTow,
@@ -203,11 +201,11 @@ int run(int argc, char** argv) {
     const std::int64_t now = canyon::core::pipeline_now_ns();
     const std::lock_guard lock(mutex);
     count_one();
-    if (kTool == "monitor") {
+    if (g_tool == "monitor") {
       model.add_solution(pl::to_sample(m, now));
       return;
     }
-    if (kTool == "echo") {
+    if (g_tool == "echo") {
       std::printf("%s\n", pl::describe(m).c_str());
       std::fflush(stdout);
       return;
@@ -240,9 +238,9 @@ int run(int argc, char** argv) {
   const auto on_timing = [&](canyon::msg::StageTiming&& m) {
     const std::lock_guard lock(mutex);
     count_one();
-    if (kTool == "monitor") {
+    if (g_tool == "monitor") {
       model.add_timing(pl::to_sample(m));
-    } else if (kTool == "echo") {
+    } else if (g_tool == "echo") {
       std::printf("%s\n", pl::describe(m).c_str());
       std::fflush(stdout);
     } else {
@@ -252,19 +250,19 @@ int run(int argc, char** argv) {
       raw << '\n';
     }
   };
-  if (kTool == "monitor" || solutions) {
-    auto r = pl::SolutionReader::create(**participant, kTool == "monitor" ? solution_topic : topic, "solution_reader",
+  if (g_tool == "monitor" || solutions) {
+    auto r = pl::SolutionReader::create(**participant, g_tool == "monitor" ? solution_topic : topic, "solution_reader",
                                         on_solution);
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     solution_reader = std::move(*r);
   }
-  if (kTool == "monitor" || ends_with(topic, "timing")) {
+  if (g_tool == "monitor" || ends_with(topic, "timing")) {
     auto r =
-        pl::TimingReader::create(**participant, kTool == "monitor" ? timing_topic : topic, "timing_reader", on_timing);
+        pl::TimingReader::create(**participant, g_tool == "monitor" ? timing_topic : topic, "timing_reader", on_timing);
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     timing_reader = std::move(*r);
   }
-  if (kTool != "monitor" && ends_with(topic, "rtcm")) {
+  if (g_tool != "monitor" && ends_with(topic, "rtcm")) {
     auto r = pl::RtcmReader::create(**participant, topic, "rtcm_reader", [&](canyon::msg::RtcmFrame&& m) {
       const std::lock_guard lock(mutex);
       count_one();
@@ -274,7 +272,7 @@ int run(int argc, char** argv) {
         if (error.empty()) error = f.error().to_string();
         return;
       }
-      if (kTool == "echo") {
+      if (g_tool == "echo") {
         std::printf("rtcm #%llu message %u station %u %d %.3f %zu bytes\n",
                     static_cast<unsigned long long>(m.sequence_number()), m.message_number(), m.station_id(),
                     m.gps_week(), m.gps_tow_s(), f->bytes.size());
@@ -290,32 +288,32 @@ int run(int argc, char** argv) {
   const auto text_sample = [&](const std::string& line) {
     const std::lock_guard lock(mutex);
     count_one();
-    if (kTool == "echo") {
+    if (g_tool == "echo") {
       std::printf("%s\n", line.c_str());
       std::fflush(stdout);
     } else {
       raw << line << '\n';
     }
   };
-  if (kTool != "monitor" && ends_with(topic, "bridged")) {
+  if (g_tool != "monitor" && ends_with(topic, "bridged")) {
     auto r = pl::BridgedReader::create(**participant, topic, "stage_reader",
                                        [&](canyon::msg::BridgedEpoch&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     bridged_reader = std::move(*r);
   }
-  if (kTool != "monitor" && ends_with(topic, "prior")) {
+  if (g_tool != "monitor" && ends_with(topic, "prior")) {
     auto r = pl::PriorReader::create(**participant, topic, "stage_reader",
                                      [&](canyon::msg::Prior&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     prior_reader = std::move(*r);
   }
-  if (kTool != "monitor" && ends_with(topic, "float")) {
+  if (g_tool != "monitor" && ends_with(topic, "float")) {
     auto r = pl::FloatReader::create(**participant, topic, "stage_reader",
                                      [&](canyon::msg::FloatSolution&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     float_reader = std::move(*r);
   }
-  if (kTool != "monitor" && ends_with(topic, "alignment")) {
+  if (g_tool != "monitor" && ends_with(topic, "alignment")) {
     auto r = pl::AlignmentReader::create(**participant, topic, "stage_reader",
                                          [&](canyon::msg::Alignment&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
@@ -323,9 +321,9 @@ int run(int argc, char** argv) {
   }
   std::unique_ptr<pl::VioPoseReader> vio_reader;
   std::unique_ptr<pl::TimeSyncReader> timesync_reader;
-  if (kTool != "monitor" && ends_with(topic, "vio")) {
+  if (g_tool != "monitor" && ends_with(topic, "vio")) {
     auto r = pl::VioPoseReader::create(**participant, topic, "vio_reader", [&](canyon::msg::VioPose&& m) {
-      if (kTool == "echo") return text_sample(pl::describe(m));
+      if (g_tool == "echo") return text_sample(pl::describe(m));
       auto pose = pl::from_msg(m);
       if (!pose) {
         const std::lock_guard lock(mutex);
@@ -338,9 +336,9 @@ int run(int argc, char** argv) {
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     vio_reader = std::move(*r);
   }
-  if (kTool != "monitor" && ends_with(topic, "timesync")) {
+  if (g_tool != "monitor" && ends_with(topic, "timesync")) {
     auto r = pl::TimeSyncReader::create(**participant, topic, "vio_reader", [&](canyon::msg::TimeSyncSample&& m) {
-      if (kTool == "echo") return text_sample(pl::describe(m));
+      if (g_tool == "echo") return text_sample(pl::describe(m));
       char line[96];
       std::snprintf(line, sizeof line, "%lld,%d,%.17g", static_cast<long long>(m.device_time_ns()), m.gps_week(),
                     m.gps_tow_s());
@@ -394,7 +392,7 @@ int run(int argc, char** argv) {
     const int m = matched();
     if (m > 0) seen_publisher = true;
     if (until_gone && seen_publisher && m == 0) break;
-    if (kTool == "monitor" && now >= next_refresh) {
+    if (g_tool == "monitor" && now >= next_refresh) {
       report();
       next_refresh += std::chrono::duration<double>(interval_s);
     }
@@ -407,7 +405,7 @@ int run(int argc, char** argv) {
   prior_reader.reset();
   float_reader.reset();
   alignment_reader.reset();
-  if (kTool == "monitor") report();
+  if (g_tool == "monitor") report();
   if (pos) {
     if (auto c = pos->close(); !c && error.empty()) error = c.error().to_string();
   }
@@ -418,7 +416,7 @@ int run(int argc, char** argv) {
     raw.close();
     if (!raw && error.empty()) error = "cannot write " + out;
   }
-  if (kTool == "record") {
+  if (g_tool == "record") {
     std::fprintf(stderr, "canyon record: %lld samples of %s to %s%s\n", static_cast<long long>(received.load()),
                  topic.c_str(), out.c_str(),
                  bad > 0 ? (" (" + std::to_string(bad) + " malformed, skipped)").c_str() : "");
@@ -427,8 +425,24 @@ int run(int argc, char** argv) {
   return 0;
 }
 
+/// "record" for .../canyon-record, and so on; empty for any other name.
+std::string tool_from_program_name(const std::string& program) {
+  const std::string name = program.substr(program.find_last_of('/') + 1);  // npos + 1 == 0: no folder
+  for (const char* tool : {"record", "echo", "monitor"}) {
+    if (name == std::string("canyon-") + tool) return tool;
+  }
+  return {};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  return canyon::apps::guarded_main("canyon-" + kTool, kExitRuntime, run, argc, argv);
+  g_tool = tool_from_program_name(argc > 0 ? argv[0] : "");
+  if (g_tool.empty()) {
+    std::cerr << "error: run this executable as canyon-record, canyon-echo or canyon-monitor (or through `canyon "
+                 "record|echo|monitor`), not as '"
+              << (argc > 0 ? argv[0] : "") << "'\n";
+    return kExitUsage;
+  }
+  return canyon::apps::guarded_main("canyon-" + g_tool, kExitRuntime, run, argc, argv);
 }

@@ -145,8 +145,11 @@ class ReplayPacer {
   /// When epoch t is due (monotonic ns); the first call anchors the replay at (t, now_ns).
   [[nodiscard]] std::int64_t due_ns(const core::GpsTime& t, std::int64_t now_ns) {
     if (!(pace_ > 0.0)) return now_ns;
-    if (!anchor_) anchor_ = Anchor{t, now_ns};
-    return anchor_->ns + static_cast<std::int64_t>((t - anchor_->t) / pace_ * 1e9);
+    if (!anchored_) {
+      anchor_ = Anchor{t, now_ns};
+      anchored_ = true;
+    }
+    return anchor_.ns + static_cast<std::int64_t>((t - anchor_.t) / pace_ * 1e9);
   }
   /// Until when epoch t waits for its base epoch (monotonic ns); may already have passed when ingest is behind.
   [[nodiscard]] std::int64_t base_deadline_ns(const core::GpsTime& t, std::int64_t now_ns) {
@@ -160,7 +163,9 @@ class ReplayPacer {
   };
   double pace_;
   std::int64_t base_wait_ns_;
-  std::optional<Anchor> anchor_;
+  // A plain flag, not std::optional: GCC 12 takes the optional's payload for uninitialised where due_ns is inlined.
+  bool anchored_ = false;
+  Anchor anchor_{};
 };
 
 /// A base whose RTCM 3 frames stream in (DDS, NTRIP, TCP). Frames are decoded as they come; at(t) waits until the base
