@@ -806,7 +806,12 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
     fix.Q_a.row(k) = fix.PDt.row(s) - fix.PDt.row(r);
   }
   fix.Q_a = 0.5 * (fix.Q_a + fix.Q_a.transpose()).eval();
-  auto search = mlambda(fix.a_float, fix.Q_a);
+  std::vector<DdKey> keys;
+  keys.reserve(dd.size());
+  for (const auto& pair : dd) keys.push_back(dd_key(pair));
+  CarriedDecorrelation& carried = carried_decorrelations_[std::move(keys)];
+  carried.last_epoch = ar_epoch_;
+  auto search = mlambda(fix.a_float, fix.Q_a, MlambdaOptions{}, &carried.warm);
   if (!search) return std::nullopt;
   fix.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
   fix.squared_norm = search->squared_norms[0];
@@ -995,6 +1000,8 @@ std::optional<RtkEngine::Fix> RtkEngine::partial_fix(const std::vector<SingleDif
 }
 
 bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch& out) {
+  ++ar_epoch_;
+  std::erase_if(carried_decorrelations_, [&](const auto& entry) { return entry.second.last_epoch < ar_epoch_ - 1; });
   const auto all = dd_ambiguities(sds, Exclusion{});
   if (static_cast<int>(all.size()) < options_.min_fix_ambiguities) {
     out.note = "too few ambiguities to fix: " + std::to_string(all.size());

@@ -23,7 +23,9 @@
 #include <limits>
 #include <numeric>
 #include <ranges>
+#include <span>
 #include <string>
+#include <utility>
 
 #include <Eigen/Cholesky>
 
@@ -269,10 +271,11 @@ Status reduce(const ReductionView& v, bool size_reduce_all) {
 /// Factorisation and reduction into dec. With log == nullptr, dec.Z_inv receives Z^{-T}; otherwise dec.Z_inv is
 /// left empty and the operations are logged (with the initial permutation) for back_transform(). dec.Z is left empty
 /// unless with_z. z_hat (with a_centred and perm) receives Z^T a_centred. Without `size_reduce_all` the final
-/// size-reduction pass is skipped (for the search: it cannot change which nodes the search visits).
+/// size-reduction pass is skipped (for the search: it cannot change which nodes the search visits). With `start`
+/// (Q_a then being start->Z^T Q start->Z, with Z and Z^{-T} kept and no log), Z and Z^{-T} accumulate from start's.
 Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool size_reduce_all, bool with_z,
                         Eigen::VectorXd* z_hat, const Eigen::VectorXd* a_centred, std::vector<Eigen::Index>* perm,
-                        std::vector<ElementaryOperation>* log) {
+                        std::vector<ElementaryOperation>* log, const MlambdaWarmStart* start = nullptr) {
   assert(z_hat == nullptr || (a_centred != nullptr && perm != nullptr));
   const Eigen::Index n = Q_a.rows();
   dec.L.resize(n, n);
@@ -284,6 +287,15 @@ Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool siz
       nullptr, perm,         log};
   Eigen::MatrixXd W;
   if (auto s = factorise_with_pivoting(Q_a, W, v); !s) return s;
+  if (start != nullptr) {
+    // Z = Z_0 P and Z^{-T} = Z_0^{-T} P (P a permutation): column i is column perm[i] of Z_0, of Z_0^{-T}.
+    assert(with_z && log == nullptr && perm != nullptr);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index from = (*perm)[static_cast<std::size_t>(i)];
+      dec.Z.col(i) = start->Z.col(from);
+      dec.Z_inv.col(i) = start->Z_inv_T.col(from);
+    }
+  }
   if (z_hat != nullptr) {
     // Z is the pivoting permutation P at this point: Z^T a = (a_perm[0], a_perm[1], ...).
     z_hat->resize(n);
@@ -409,6 +421,114 @@ Result<std::vector<int>> complement_of(const std::vector<int>& indices, Eigen::I
   return rest;
 }
 
+bool warm_start_fits(const MlambdaWarmStart& warm, Eigen::Index n) {
+  return warm.Z.rows() == n && warm.Z.cols() == n && warm.Z_inv_T.rows() == n && warm.Z_inv_T.cols() == n;
+}
+
+/// Z^T Q Z for a symmetric Q and an integer Z, by the non-zero entries of Z (a carried decorrelation has about a third
+/// non-zero, all small): about a third of the dense products' work, and no temporaries of the dense product.
+Eigen::MatrixXd congruence(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Z) {
+  const Eigen::Index n = Q.rows();
+  std::vector<std::pair<Eigen::Index, double>> nonzeros;  // (row, value) column by column
+  std::vector<std::size_t> column_start(static_cast<std::size_t>(n) + 1, 0);
+  nonzeros.reserve(static_cast<std::size_t>(n * n));
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (Z(k, j) != 0.0) nonzeros.emplace_back(k, Z(k, j));
+    }
+    column_start[static_cast<std::size_t>(j) + 1] = nonzeros.size();
+  }
+  const auto column = [&](Eigen::Index j) {
+    return std::span(nonzeros).subspan(
+        column_start[static_cast<std::size_t>(j)],
+        column_start[static_cast<std::size_t>(j) + 1] - column_start[static_cast<std::size_t>(j)]);
+  };
+  Eigen::MatrixXd QZ = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (const auto& [k, z] : column(j)) QZ.col(j) += z * Q.col(k);
+  }
+  Eigen::MatrixXd out(n, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = 0; i <= j; ++i) {
+      double sum = 0.0;
+      for (const auto& [k, z] : column(i)) sum += z * QZ(k, j);
+      out(i, j) = sum;
+      out(j, i) = sum;
+    }
+  }
+  return out;
+}
+
+/// Entries this large suggest the carried basis has drifted: the next search starts cold (the products below stay
+/// exact in double far beyond, this only keeps them small).
+constexpr double kMaxWarmStartEntry = 1048576.0;  // 2^20
+
+/// The body of mlambda(). `warm`, when not nullptr, is empty (cold start) or fits the problem; the decorrelation
+/// reached is stored in it.
+Result<IntegerSearchResult> solve_integer_least_squares(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a,
+                                                        const MlambdaOptions& options, MlambdaWarmStart* warm) {
+  if (auto s = options.validate(); !s) return Error("mlambda: " + s.error().message);
+  if (auto s = check_problem(a_float, Q_a, "mlambda"); !s) return s.error();
+  if (auto s = check_symmetric(Q_a, "mlambda"); !s) return s.error();
+  const bool from_warm = warm != nullptr && warm->Z.size() > 0;
+
+  // Without a warm start, dec.Z_inv stays empty (the candidates are back-transformed through the operation log) and
+  // dec.Z unless kept; with one, Z and Z^{-T} accumulate (from the carried ones, if any), no log is kept, and L is
+  // size-reduced in full, which keeps the carried basis small.
+  Decorrelation dec;
+  const Eigen::VectorXd shift = a_float.unaryExpr(&round_half_away);
+  Eigen::VectorXd a_centred = a_float - shift;
+  Eigen::VectorXd z_hat;
+  std::vector<Eigen::Index> perm;
+  std::vector<ElementaryOperation> log;
+  Status decorrelated = Ok{};
+  if (warm != nullptr) {
+    if (from_warm) {
+      a_centred = warm->Z.transpose() * a_centred;  // a' = Z_0^T (a_float - shift)
+      const Eigen::MatrixXd Q_start = congruence(Q_a, warm->Z);
+      decorrelated = decorrelate_into(Q_start, dec, true, true, &z_hat, &a_centred, &perm, nullptr, warm);
+    } else {
+      decorrelated = decorrelate_into(Q_a, dec, true, true, &z_hat, &a_centred, &perm, nullptr);
+    }
+  } else {
+    log.reserve(1024);
+    decorrelated = decorrelate_into(Q_a, dec, options.with_z, options.with_z, &z_hat, &a_centred, &perm, &log);
+  }
+  if (!decorrelated) return decorrelated.error();
+
+  IntegerSearchResult out;
+  auto found = search(dec, z_hat, options.num_candidates, options.max_search_nodes, out.search_nodes);
+  if (!found) return found.error();
+  const int m = found->count;
+  std::vector<int> order(static_cast<std::size_t>(m));
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](int l, int r) { return found->squared_norms(l) < found->squared_norms(r); });
+  Eigen::MatrixXd z_sorted(a_float.size(), m);
+  out.squared_norms.resize(m);
+  for (int j = 0; j < m; ++j) {
+    const int from = order[static_cast<std::size_t>(j)];
+    z_sorted.col(j) = found->z.col(from);
+    out.squared_norms(j) = found->squared_norms(from);
+  }
+  // a = Z^{-T} z, exact: integers.
+  out.candidates = warm != nullptr ? Eigen::MatrixXd(dec.Z_inv * z_sorted) : back_transform(log, perm, z_sorted);
+  out.candidates.colwise() += shift;
+  if (warm != nullptr) {
+    const bool small =
+        dec.Z.cwiseAbs().maxCoeff() <= kMaxWarmStartEntry && dec.Z_inv.cwiseAbs().maxCoeff() <= kMaxWarmStartEntry;
+    if (small) {
+      warm->Z = dec.Z;
+      warm->Z_inv_T = std::move(dec.Z_inv);
+    } else {
+      *warm = {};
+    }
+  }
+  if (options.with_z) out.Z = std::move(dec.Z);
+  out.conditional_variances = std::move(dec.d);
+  return out;
+}
+
 }  // namespace
 
 Status MlambdaOptions::validate() const {
@@ -429,41 +549,10 @@ Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a) {
 }
 
 Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a,
-                                    const MlambdaOptions& options) {
-  if (auto s = options.validate(); !s) return Error("mlambda: " + s.error().message);
-  if (auto s = check_problem(a_float, Q_a, "mlambda"); !s) return s.error();
-  if (auto s = check_symmetric(Q_a, "mlambda"); !s) return s.error();
-
-  // dec.Z_inv stays empty (the candidates are back-transformed through the operation log), dec.Z unless with_z.
-  Decorrelation dec;
-  const Eigen::VectorXd shift = a_float.unaryExpr(&round_half_away);
-  const Eigen::VectorXd a_centred = a_float - shift;
-  Eigen::VectorXd z_hat;
-  std::vector<Eigen::Index> perm;
-  std::vector<ElementaryOperation> log;
-  log.reserve(1024);
-  if (auto s = decorrelate_into(Q_a, dec, options.with_z, options.with_z, &z_hat, &a_centred, &perm, &log); !s)
-    return s.error();
-
-  IntegerSearchResult out;
-  auto found = search(dec, z_hat, options.num_candidates, options.max_search_nodes, out.search_nodes);
-  if (!found) return found.error();
-  const int m = found->count;
-  std::vector<int> order(static_cast<std::size_t>(m));
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](int l, int r) { return found->squared_norms(l) < found->squared_norms(r); });
-  Eigen::MatrixXd z_sorted(a_float.size(), m);
-  out.squared_norms.resize(m);
-  for (int j = 0; j < m; ++j) {
-    const int from = order[static_cast<std::size_t>(j)];
-    z_sorted.col(j) = found->z.col(from);
-    out.squared_norms(j) = found->squared_norms(from);
-  }
-  out.candidates = back_transform(log, perm, z_sorted);  // exact: integers
-  out.candidates.colwise() += shift;
-  out.Z = std::move(dec.Z);
-  out.conditional_variances = std::move(dec.d);
+                                    const MlambdaOptions& options, MlambdaWarmStart* warm) {
+  if (warm != nullptr && !warm_start_fits(*warm, a_float.size())) *warm = {};
+  auto out = solve_integer_least_squares(a_float, Q_a, options, warm);
+  if (!out && warm != nullptr) *warm = {};
   return out;
 }
 

@@ -41,7 +41,9 @@ using canyon::rtk::testing::IlsProblem;
 constexpr int kProblemsPerCase = 64;
 constexpr int kRepetitions = 15;
 
-void time_mlambda(benchmark::State& state, const std::vector<IlsProblem>& problems) {
+/// With `warm`, the problems are a sequence (each an epoch after the last) searched with the decorrelation carried.
+void time_mlambda(benchmark::State& state, const std::vector<IlsProblem>& problems,
+                  canyon::rtk::MlambdaWarmStart* warm = nullptr) {
   std::size_t next = 0;
   std::int64_t nodes = 0;
   std::vector<double> call_us;
@@ -49,7 +51,7 @@ void time_mlambda(benchmark::State& state, const std::vector<IlsProblem>& proble
   for (auto _ : state) {  // NOLINT(clang-analyzer-deadcode.DeadStores): Google Benchmark's loop idiom
     const auto& p = problems[next++ % problems.size()];
     const auto start = std::chrono::steady_clock::now();
-    auto result = canyon::rtk::mlambda(p.a_float, p.Q_a);
+    auto result = canyon::rtk::mlambda(p.a_float, p.Q_a, canyon::rtk::MlambdaOptions{}, warm);
     benchmark::DoNotOptimize(result);
     const auto stop = std::chrono::steady_clock::now();
     if (!result) {
@@ -90,8 +92,28 @@ void BM_MlambdaSingleEpochWorstCase(benchmark::State& state) {
   time_mlambda(state, problems);
 }
 
+/// EKF ambiguities epoch after epoch (tests/rtk/gnss_like.hpp ekf_ambiguity_sequence), searched cold (warm = 0) or with
+/// the decorrelation carried from each search to the next (warm = 1), as canyon's RTK engine does for an unchanged
+/// set of ambiguities.
+void BM_MlambdaSequence(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  canyon::rtk::testing::EkfAmbiguityOptions options;
+  options.num_satellites = n / 2 + 1;
+  options.num_epochs = 5;
+  const auto problems =
+      canyon::rtk::testing::ekf_ambiguity_sequence(options, 7 + static_cast<unsigned>(n), kProblemsPerCase);
+  canyon::rtk::MlambdaWarmStart warm;
+  time_mlambda(state, problems, state.range(1) != 0 ? &warm : nullptr);
+}
+
 }  // namespace
 
+BENCHMARK(BM_MlambdaSequence)
+    ->ArgNames({"n", "warm"})
+    ->ArgsProduct({{10, 20, 30}, {0, 1}})
+    ->Repetitions(kRepetitions)
+    ->ReportAggregatesOnly(true)
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Mlambda)
     ->ArgNames({"n", "epochs"})
     ->ArgsProduct({{10, 20, 30}, {1, 5, 20}})

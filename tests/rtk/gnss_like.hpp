@@ -194,4 +194,19 @@ inline IlsProblem ekf_ambiguity_problem(const EkfAmbiguityOptions& options, std:
   return p;
 }
 
+/// The problem of ekf_ambiguity_problem() epoch after epoch: the same satellites (their geometry drawn from `seed`),
+/// options.num_epochs epochs of data in the first problem and one more in each next (for warm starts of the search).
+inline std::vector<IlsProblem> ekf_ambiguity_sequence(EkfAmbiguityOptions options, std::uint64_t seed, int count) {
+  std::vector<IlsProblem> out;
+  std::mt19937_64 noise(seed + 1);
+  for (int k = 0; k < count; ++k, ++options.num_epochs) {
+    std::mt19937_64 geometry(seed);
+    IlsProblem p;
+    p.Q_a = ekf_ambiguity_covariance(options, geometry);
+    p.a_float = sample_float(p.Q_a, noise);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 }  // namespace canyon::rtk::testing

@@ -365,6 +365,51 @@ TEST(MlambdaTest, WithZReturnsTheDecorrelationAndTheSameCandidates) {
   }
 }
 
+TEST(MlambdaTest, WarmStartGivesTheCandidatesOfAColdStartAndCarriesAnExactUnimodularBasis) {
+  // An EKF's ambiguities epoch after epoch, each searched cold and warm (the decorrelation carried from the last
+  // search): the same candidates, the same norms up to rounding, and the carried Z unimodular with Z^{-T} exact.
+  for (int satellites : {5, 10, 16}) {
+    testing::EkfAmbiguityOptions options;
+    options.num_satellites = satellites;
+    options.num_epochs = 2;
+    MlambdaWarmStart warm;
+    int epoch = 0;
+    for (testing::IlsProblem& p : testing::ekf_ambiguity_sequence(options, 83 + satellites, 20)) {
+      p.a_float.array() += 1.0e7;  // large ambiguities keep their fractional part
+      const auto cold = mlambda(p.a_float, p.Q_a);
+      const auto carried = mlambda(p.a_float, p.Q_a, MlambdaOptions{}, &warm);
+      ASSERT_TRUE(cold.ok() && carried.ok()) << "satellites " << satellites << " epoch " << epoch;
+      EXPECT_EQ(cold->candidates, carried->candidates) << "satellites " << satellites << " epoch " << epoch;
+      for (Eigen::Index j = 0; j < cold->squared_norms.size(); ++j) {
+        EXPECT_NEAR(cold->squared_norms[j], carried->squared_norms[j], 1e-9 * cold->squared_norms[j]);
+      }
+      const Eigen::Index n = p.a_float.size();
+      ASSERT_EQ(warm.Z.rows(), n);
+      ASSERT_EQ(warm.Z_inv_T.rows(), n);
+      EXPECT_EQ(warm.Z, warm.Z.array().round().matrix());
+      EXPECT_EQ(Eigen::MatrixXd(warm.Z.transpose() * warm.Z_inv_T), Eigen::MatrixXd::Identity(n, n));
+      ++epoch;
+    }
+  }
+}
+
+TEST(MlambdaTest, WarmStartOfAnotherSizeStartsColdAndAFailedSearchForgetsIt) {
+  std::mt19937_64 rng(89);
+  const auto p = testing::gnss_like_problem(8, rng);
+  MlambdaWarmStart warm;
+  warm.Z = Eigen::MatrixXd::Identity(5, 5);
+  warm.Z_inv_T = Eigen::MatrixXd::Identity(5, 5);
+  const auto result = mlambda(p.a_float, p.Q_a, MlambdaOptions{}, &warm);
+  ASSERT_TRUE(result.ok());
+  EXPECT_EQ(result->candidates, mlambda(p.a_float, p.Q_a)->candidates);
+  EXPECT_EQ(warm.Z.rows(), 8);
+  MlambdaOptions capped;
+  capped.max_search_nodes = 1;
+  EXPECT_FALSE(mlambda(p.a_float, p.Q_a, capped, &warm).ok());
+  EXPECT_EQ(warm.Z.size(), 0);
+  EXPECT_EQ(warm.Z_inv_T.size(), 0);
+}
+
 TEST(MlambdaTest, DeJongeTiberiusExample) {
   // Three-dimensional example of de Jonge & Tiberius (1996, LGR-12) and Teunissen's LAMBDA papers, numbers as
   // recalled from the literature: a_float = (5.45, 3.10, 2.97), Q_a below; the published ILS solution is (5, 3, 4).

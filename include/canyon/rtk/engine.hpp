@@ -79,6 +79,7 @@
 #include "canyon/gnss/spp.hpp"
 #include "canyon/rtk/cycle_slip.hpp"
 #include "canyon/rtk/epoch_geometry.hpp"
+#include "canyon/rtk/lambda.hpp"
 #include "canyon/rtk/observables.hpp"
 
 namespace canyon::rtk {
@@ -351,8 +352,17 @@ class RtkEngine {
   int last_code_rows_ = 0;
   static constexpr int kFullSetRetryEpochs = 10;
   std::vector<DdKey> failed_full_set_;  // the full DD set whose integer search last failed (empty: none)
-  int epochs_since_full_set_ = 0;       // epochs since the full set was last searched
-  bool iono_estimated_ = false;         // ionosphere states in use at this epoch
+  // The decorrelation each DD set's integer search reached, carried to the next search of the same set (a warm
+  // start: a few reduction swaps instead of hundreds, the same candidates); a set not searched in an epoch is
+  // forgotten at the next. Only an accelerator, hence mutable in the const searches.
+  struct CarriedDecorrelation {
+    MlambdaWarmStart warm;
+    std::int64_t last_epoch = 0;  // ar_epoch_ of its last search
+  };
+  mutable std::map<std::vector<DdKey>, CarriedDecorrelation> carried_decorrelations_;
+  std::int64_t ar_epoch_ = 0;      // epochs through resolve_ambiguities
+  int epochs_since_full_set_ = 0;  // epochs since the full set was last searched
+  bool iono_estimated_ = false;    // ionosphere states in use at this epoch
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);

@@ -42,6 +42,12 @@
 //                 infinite until m leaves are found, then the m-th best squared norm.
 //              a_float is first shifted by round(a_float) (an integer shift commutes with the unimodular Z) so
 //              large ambiguities (1e7 cycles) do not lose the fractional part.
+//              Warm start (optional in/out argument): a unimodular Z_0 from an earlier search of a similar problem
+//              (the same ambiguities an epoch later) is applied first, a' = Z_0^T a_float, Q' = Z_0^T Q_a Z_0, and
+//              steps 1-3 run on (a', Q'), which is nearly reduced already: a few swaps instead of hundreds. The
+//              problem is the same in any unimodular basis, so the candidates a = Z_0^{-T} a' and their norms are
+//              those of a cold start; Z and d are those of the basis reached (the same reduction conditions hold).
+//              On return the argument holds Z_0 Z_1 and its inverse, for the next search.
 //   Errors:    n == 0, size mismatch, non-finite input, Q_a not symmetric or not positive definite,
 //              m < 1, search exceeding options.max_search_nodes, reduction not terminating (cap 1e6 steps).
 // ---------------------------------------------------------------------------------------------------------------
@@ -85,9 +91,18 @@ struct Decorrelation {
 /// Steps 1-2 of the contract: validated L^T D L factorisation with symmetric pivoting and reduction of Q_a.
 [[nodiscard]] Result<Decorrelation> decorrelate(const Eigen::MatrixXd& Q_a);
 
-/// Integer least squares by MLAMBDA; see the contract block at the top of this header.
+/// A decorrelation carried from one search to the next (see "Warm start" in the contract). Empty, or of another
+/// size than the problem: a cold start.
+struct MlambdaWarmStart {
+  Eigen::MatrixXd Z;        ///< n x n unimodular (integer entries stored as double)
+  Eigen::MatrixXd Z_inv_T;  ///< Z^{-T}, exact integers
+};
+
+/// Integer least squares by MLAMBDA; see the contract block at the top of this header. With `warm` (may be nullptr),
+/// the search starts from warm->Z when it has the problem's size, and *warm receives the decorrelation reached
+/// (emptied when the search fails or its entries grow beyond 2^20, so that the next search starts cold).
 [[nodiscard]] Result<IntegerSearchResult> mlambda(const Eigen::VectorXd& a_float, const Eigen::MatrixXd& Q_a,
-                                                  const MlambdaOptions& options = {});
+                                                  const MlambdaOptions& options = {}, MlambdaWarmStart* warm = nullptr);
 
 /// Outcome of the ratio test.
 struct RatioTestOutcome {
