@@ -458,15 +458,23 @@ void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp
     }
     initialised_ = true;
   } else {
-    // Constant acceleration: x' = F x, P' = F P F^T + Q with white jerk of the given spectral density (ENU).
-    Eigen::MatrixXd F = Eigen::MatrixXd::Identity(x_.size(), x_.size());
+    // Constant acceleration: x' = F x, P' = F P F^T + Q with white jerk of the given spectral density (ENU). F is
+    // the identity but for its kinematic block F_k, so P_kk' = F_k P_kk F_k^T, P_ka' = F_k P_ka and the ambiguity
+    // block is unchanged: O(81 N) instead of the O(N^3) of the whole product.
+    constexpr int kKinematic = 9;
+    Eigen::Matrix<double, kKinematic, kKinematic> F_k = Eigen::Matrix<double, kKinematic, kKinematic>::Identity();
     for (int i = 0; i < 3; ++i) {
-      F(i, 3 + i) = dt_s;
-      F(i, 6 + i) = 0.5 * dt_s * dt_s;
-      F(3 + i, 6 + i) = dt_s;
+      F_k(i, 3 + i) = dt_s;
+      F_k(i, 6 + i) = 0.5 * dt_s * dt_s;
+      F_k(3 + i, 6 + i) = dt_s;
     }
-    x_ = F * x_;
-    P_ = F * P_ * F.transpose();
+    const Eigen::Index m = x_.size() - kKinematic;
+    x_.head<kKinematic>() = F_k * x_.head<kKinematic>();
+    P_.topLeftCorner<kKinematic, kKinematic>() = F_k * P_.topLeftCorner<kKinematic, kKinematic>() * F_k.transpose();
+    if (m > 0) {
+      P_.topRightCorner(kKinematic, m) = F_k * P_.topRightCorner(kKinematic, m);
+      P_.bottomLeftCorner(m, kKinematic) = P_.topRightCorner(kKinematic, m).transpose();
+    }
     const core::Geodetic g = core::ecef_to_geodetic(x_.head<3>());
     const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(g).transpose();
     Eigen::Matrix3d Q_N = Eigen::Matrix3d::Zero();

@@ -172,6 +172,33 @@ TEST(RtkSimulator, InstinctBothVariantsBothRoversFixedWithinOneCentimetre) {
   }
 }
 
+TEST(RtkSimulator, InstinctDynamicRoverWithTheConstantAccelerationModel) {
+  // dynamics: true (RTKLIB's "dynamics on"): position, velocity and acceleration carried by the motion model instead
+  // of re-initialised from the single-point solution each epoch; the same accuracy on the moving rover.
+  REQUIRE_DATA("instinct-spirent-rtk-sim");
+  const Eigen::Vector3d base(4157177.06580187, 671230.476590636, 4774767.03105544);
+  auto truth =
+      eval::read_spirent_pva_csv((shared_data() / "instinct-spirent-rtk-sim/Rover-dynamic_PVA_Spirent.csv").string());
+  ASSERT_TRUE(truth.ok()) << truth.error().to_string();
+  const std::string dir = "instinct-spirent-rtk-sim/iono-Klob_tropo-Saast/";
+  auto run = run_rtk("instinct_dynamics", dir + "Rover-dynamic_MO_Spirent.obs", dir + "Base-static_MO_Spirent.obs",
+                     {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
+                     base, [](app::ProcessConfig& c) {
+                       c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
+                       c.rtk.dynamics = true;
+                     });
+  ASSERT_TRUE(run.has_value());
+  eval::EvalOptions options;
+  options.wrong_fix_threshold_m = kWrongFixM;
+  auto stats = eval::evaluate(run->solutions, *truth, options);
+  ASSERT_TRUE(stats.ok());
+  std::cout << "[ RTK      ] instinct dynamic, constant-acceleration model: " << stats->fixed().epochs << "/"
+            << run->summary.epochs << " fixed, 3D RMSE " << stats->overall.rmse_3d_m << " m\n";
+  EXPECT_GE(stats->fixed().epochs, run->summary.epochs * 99 / 100);
+  EXPECT_LE(stats->overall.rmse_3d_m, kMaxStaticRmse3dM);
+  EXPECT_EQ(stats->wrong_fixes, 0);
+}
+
 /// cssrlib-kinematic-doy265: fix rate at least RTKLIB's in the same AR mode, fixed positions within 3 cm of
 /// RTKLIB's where both are fixed (RTKLIB's results are the ones shipped with the dataset).
 TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
