@@ -79,7 +79,9 @@ const char* map_plain_file(const std::string& path, std::size_t& size) {
         ::munmap(p, size);
         map = nullptr;
       } else {
-        ::madvise(p, size, MADV_SEQUENTIAL | MADV_WILLNEED);
+        // Two calls: the advice values are not flags (MADV_SEQUENTIAL | MADV_WILLNEED is MADV_WILLNEED alone).
+        ::madvise(p, size, MADV_SEQUENTIAL);
+        ::madvise(p, size, MADV_WILLNEED);
       }
     }
   }
