@@ -297,7 +297,8 @@ Status decorrelate_into(const Eigen::MatrixXd& Q_a, Decorrelation& dec, bool siz
     }
   }
   if (z_hat != nullptr) {
-    // Z is the pivoting permutation P at this point: Z^T a = (a_perm[0], a_perm[1], ...).
+    // Z is the pivoting permutation P at this point, or Z_0 P with a_centred = Z_0^T a already (warm start):
+    // Z^T a = (a_perm[0], a_perm[1], ...) of a_centred either way.
     z_hat->resize(n);
     for (Eigen::Index i = 0; i < n; ++i) (*z_hat)[i] = (*a_centred)[(*perm)[static_cast<std::size_t>(i)]];
     v.z_hat = z_hat->data();
