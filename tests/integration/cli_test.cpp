@@ -50,6 +50,30 @@ TEST(CanyonCli, MissingInputsAreNamed) {
   EXPECT_NE(no_out.output.find("solution file is required"), std::string::npos) << no_out.output;
 }
 
+TEST(CanyonCli, TopicToolsAreOneExecutableThatTheNameSelects) {
+  // canyon-record and canyon-echo are links to canyon-monitor; each name gets its own options, any other is refused.
+  const fs::path monitor = fs::path(CANYON_BINARY).parent_path() / "canyon-monitor";
+  if (!fs::exists(monitor)) GTEST_SKIP() << monitor << " not built (a build without Fast DDS)";
+  const auto record = canyon("record --help");
+  EXPECT_EQ(record.exit_code, 0) << record.output;
+  EXPECT_NE(record.output.find("--out"), std::string::npos) << record.output;
+  const auto echo = canyon("echo --help");
+  EXPECT_EQ(echo.exit_code, 0) << echo.output;
+  EXPECT_NE(echo.output.find("topic"), std::string::npos) << echo.output;
+  EXPECT_EQ(echo.output.find("--out"), std::string::npos) << echo.output;
+  const auto monitor_help = canyon("monitor --help");
+  EXPECT_EQ(monitor_help.exit_code, 0) << monitor_help.output;
+  EXPECT_NE(monitor_help.output.find("--json"), std::string::npos) << monitor_help.output;
+  const fs::path other = test::temp_dir("cli") / "canyon-bogus";
+  fs::remove(other);
+  fs::create_symlink(monitor, other);
+  const auto refused = test::run_command(other.string() + " --help");
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("run this executable as canyon-record, canyon-echo or canyon-monitor"),
+            std::string::npos)
+      << refused.output;
+}
+
 TEST(CanyonCli, BadConfigKeyNamesFileAndLine) {
   const fs::path config = test::temp_dir("cli") / "bad.yaml";
   std::ofstream(config) << "mode: spp\nspp:\n  elevation_mask: 10\n";
