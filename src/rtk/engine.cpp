@@ -814,10 +814,7 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
     fix.Q_a.row(k) = fix.PDt.row(s) - fix.PDt.row(r);
   }
   fix.Q_a = 0.5 * (fix.Q_a + fix.Q_a.transpose()).eval();
-  std::vector<DdKey> keys;
-  keys.reserve(dd.size());
-  for (const auto& pair : dd) keys.push_back(dd_key(pair));
-  CarriedDecorrelation& carried = carried_decorrelations_[std::move(keys)];
+  CarriedDecorrelation& carried = carried_decorrelations_[dd_keys(dd)];
   carried.last_epoch = ar_epoch_;
   auto search = mlambda(fix.a_float, fix.Q_a, MlambdaOptions{}, &carried.warm);
   if (!search) return std::nullopt;
@@ -841,6 +838,13 @@ RtkEngine::DdKey RtkEngine::dd_key(const std::pair<int, int>& dd) const {
   const auto k = static_cast<std::size_t>(num_kinematic_states());
   return {ambiguity_keys_[static_cast<std::size_t>(dd.first) - k],
           ambiguity_keys_[static_cast<std::size_t>(dd.second) - k]};
+}
+
+std::vector<RtkEngine::DdKey> RtkEngine::dd_keys(const std::vector<std::pair<int, int>>& dd) const {
+  std::vector<DdKey> keys;
+  keys.reserve(dd.size());
+  for (const auto& pair : dd) keys.push_back(dd_key(pair));
+  return keys;
 }
 
 std::string RtkEngine::rejection_reason(const Fix& fix) const {
@@ -1018,9 +1022,7 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the
   // float ambiguities left out, which are biased when the full set fails.
   const auto min_size = static_cast<int>(std::ceil(options_.min_partial_fraction * static_cast<double>(all.size())));
-  std::vector<DdKey> all_keys;
-  all_keys.reserve(all.size());
-  for (const auto& pair : all) all_keys.push_back(dd_key(pair));
+  const std::vector<DdKey> all_keys = dd_keys(all);
   // The same full set failed at the last epoch and a subset was fixed: the subset is tried first, and the full set
   // again only every kFullSetRetryEpochs epochs (or when the set changes). One epoch more of data seldom turns a
   // failing set around, and each integer search of the full set costs as much as the rest of the epoch.

@@ -23,9 +23,7 @@
 #include <limits>
 #include <numeric>
 #include <ranges>
-#include <span>
 #include <string>
-#include <utility>
 
 #include <Eigen/Cholesky>
 
@@ -426,40 +424,6 @@ bool warm_start_fits(const MlambdaWarmStart& warm, Eigen::Index n) {
   return warm.Z.rows() == n && warm.Z.cols() == n && warm.Z_inv_T.rows() == n && warm.Z_inv_T.cols() == n;
 }
 
-/// Z^T Q Z for a symmetric Q and an integer Z, by the non-zero entries of Z (a carried decorrelation has about a third
-/// non-zero, all small): about a third of the dense products' work, and no temporaries of the dense product.
-Eigen::MatrixXd congruence(const Eigen::MatrixXd& Q, const Eigen::MatrixXd& Z) {
-  const Eigen::Index n = Q.rows();
-  std::vector<std::pair<Eigen::Index, double>> nonzeros;  // (row, value) column by column
-  std::vector<std::size_t> column_start(static_cast<std::size_t>(n) + 1, 0);
-  nonzeros.reserve(static_cast<std::size_t>(n * n));
-  for (Eigen::Index j = 0; j < n; ++j) {
-    for (Eigen::Index k = 0; k < n; ++k) {
-      if (Z(k, j) != 0.0) nonzeros.emplace_back(k, Z(k, j));
-    }
-    column_start[static_cast<std::size_t>(j) + 1] = nonzeros.size();
-  }
-  const auto column = [&](Eigen::Index j) {
-    return std::span(nonzeros).subspan(
-        column_start[static_cast<std::size_t>(j)],
-        column_start[static_cast<std::size_t>(j) + 1] - column_start[static_cast<std::size_t>(j)]);
-  };
-  Eigen::MatrixXd QZ = Eigen::MatrixXd::Zero(n, n);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    for (const auto& [k, z] : column(j)) QZ.col(j) += z * Q.col(k);
-  }
-  Eigen::MatrixXd out(n, n);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    for (Eigen::Index i = 0; i <= j; ++i) {
-      double sum = 0.0;
-      for (const auto& [k, z] : column(i)) sum += z * QZ(k, j);
-      out(i, j) = sum;
-      out(j, i) = sum;
-    }
-  }
-  return out;
-}
-
 /// Entries this large suggest the carried basis has drifted: the next search starts cold (the products below stay
 /// exact in double far beyond, this only keeps them small).
 constexpr double kMaxWarmStartEntry = 1048576.0;  // 2^20
@@ -485,8 +449,8 @@ Result<IntegerSearchResult> solve_integer_least_squares(const Eigen::VectorXd& a
   Status decorrelated = Ok{};
   if (warm != nullptr) {
     if (from_warm) {
-      a_centred = warm->Z.transpose() * a_centred;  // a' = Z_0^T (a_float - shift)
-      const Eigen::MatrixXd Q_start = congruence(Q_a, warm->Z);
+      a_centred = warm->Z.transpose() * a_centred;                          // a' = Z_0^T (a_float - shift)
+      const Eigen::MatrixXd Q_start = warm->Z.transpose() * Q_a * warm->Z;  // symmetrised by the factorisation
       decorrelated = decorrelate_into(Q_start, dec, true, true, &z_hat, &a_centred, &perm, nullptr, warm);
     } else {
       decorrelated = decorrelate_into(Q_a, dec, true, true, &z_hat, &a_centred, &perm, nullptr);
@@ -519,7 +483,7 @@ Result<IntegerSearchResult> solve_integer_least_squares(const Eigen::VectorXd& a
     const bool small =
         dec.Z.cwiseAbs().maxCoeff() <= kMaxWarmStartEntry && dec.Z_inv.cwiseAbs().maxCoeff() <= kMaxWarmStartEntry;
     if (small) {
-      warm->Z = dec.Z;
+      warm->Z = options.with_z ? dec.Z : std::move(dec.Z);
       warm->Z_inv_T = std::move(dec.Z_inv);
     } else {
       *warm = {};

@@ -292,6 +292,7 @@ class RtkEngine {
   /// A DD ambiguity by the keys of its two SD ambiguities (satellite s, reference satellite).
   using DdKey = std::pair<AmbiguityKey, AmbiguityKey>;
   [[nodiscard]] DdKey dd_key(const std::pair<int, int>& dd) const;
+  [[nodiscard]] std::vector<DdKey> dd_keys(const std::vector<std::pair<int, int>>& dd) const;
   /// False if a DD ambiguity also fixed at the last fix (no slip since) gets another integer: a fix that contradicts
   /// its predecessor is a wrong fix of one of them, and is not taken.
   [[nodiscard]] bool agrees_with_last_fix(const Fix& fix) const;
