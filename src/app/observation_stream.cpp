@@ -31,9 +31,9 @@ io::GnssStreamOptions rtcm_options(const core::GpsTime& reference) {
 }  // namespace
 
 Result<ObservationStream> ObservationStream::open(const std::string& path, const io::ObsFilter& filter,
-                                                  const std::optional<core::GpsTime>& reference) {
+                                                  const std::optional<core::GpsTime>& reference, bool read_ahead) {
   if (!is_rtcm_path(path)) {
-    auto reader = io::ObsReadAhead::open(path, filter);
+    auto reader = io::ObsReadAhead::open(path, filter, read_ahead ? io::ObsReadAhead::kDefaultDepth : 0);
     if (!reader) return reader.error();
     return ObservationStream(std::move(*reader), path);
   }

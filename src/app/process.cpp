@@ -456,14 +456,16 @@ Result<ProcessSummary> run_process(const ProcessConfig& input_config, const Prog
   ProcessSummary summary;
 
   // The observation files start parsing on their own threads while the navigation files are read; errors are
-  // still reported navigation first.
+  // still reported navigation first. The bridge-ahead pipeline (rtk and fusion modes) parses them on its ingest
+  // thread instead: two busy threads are what two cores run best.
   const io::ObsFilter filter = observation_filter(config);
-  auto rover = ObservationStream::open(config.rover_obs, filter);
+  const bool read_ahead = config.mode == ProcessMode::Spp || pipeline.threaded || !pipeline.bridge_ahead;
+  auto rover = ObservationStream::open(config.rover_obs, filter, std::nullopt, read_ahead);
   std::optional<Result<ObservationStream>> base_stream;
   if (config.mode != ProcessMode::Spp) {
     // An RTCM 3 base file dates its epochs from the rover's first epoch.
     const std::optional<core::GpsTime> reference = rover ? rover->header().first_obs : std::nullopt;
-    base_stream.emplace(ObservationStream::open(config.base_obs, filter, reference));
+    base_stream.emplace(ObservationStream::open(config.base_obs, filter, reference, read_ahead));
   }
 
   auto nav = read_navigation(config.nav, summary.warnings);

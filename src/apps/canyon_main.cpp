@@ -75,7 +75,7 @@ struct ProcessArgs {
   bool print_config = false;
   bool quiet = false;
   bool verbose = false;
-  std::string pipeline;
+  std::string pipeline = "bridge-ahead";
 };
 
 void add_process_command(CLI::App& app, ProcessArgs& args) {
@@ -104,9 +104,10 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
       ->check(CLI::Range(0.0, 89.9));
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
   cmd->add_option("--pipeline", args.pipeline,
-                  "rtk and fusion: run the six stages sequential (one thread, the default) or threaded (six "
-                  "threads and queues, as canyon rover); both give the same solutions")
-      ->check(CLI::IsMember({"sequential", "threaded"}));
+                  "rtk and fusion: run the six stages bridge-ahead (the default: ingest and the time bridge on a "
+                  "second thread, ahead of the other four), sequential (one thread) or threaded (six threads and "
+                  "queues, as canyon rover); all three give the same solutions")
+      ->check(CLI::IsMember({"bridge-ahead", "sequential", "threaded"}));
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
   cmd->add_flag("-v,--verbose", args.verbose, "Log why epochs got no solution or, in rtk mode, no fix (first 100)");
 }
@@ -193,6 +194,7 @@ int run_process_command(const ProcessArgs& args) {
   ProgressBar bar(!args.quiet);
   canyon::app::PipelineOptions pipeline;
   pipeline.threaded = args.pipeline == "threaded";
+  pipeline.bridge_ahead = args.pipeline == "bridge-ahead";
   auto summary = canyon::app::run_process(
       config, [&bar](int epochs, double fraction) { bar.update(epochs, fraction); }, pipeline);
   bar.finish();

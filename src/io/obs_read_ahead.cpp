@@ -41,12 +41,14 @@ Result<ObsReadAhead> ObsReadAhead::open(const std::string& path, std::optional<O
   auto reader = RinexObsReader::open(path, filter);
   if (!reader) return reader.error();
   RinexObsHeader header = reader->header();
-  return ObsReadAhead(std::move(header), std::make_unique<Shared>(std::move(*reader), depth == 0 ? 1 : depth));
+  const bool threaded = depth > 0;
+  return ObsReadAhead(std::move(header), std::make_unique<Shared>(std::move(*reader), std::max<std::size_t>(depth, 1)),
+                      threaded);
 }
 
-ObsReadAhead::ObsReadAhead(RinexObsHeader header, std::unique_ptr<Shared> shared)
-    : header_(std::move(header)), shared_(std::move(shared)) {
-  thread_ = std::thread([s = shared_.get()] { s->run(); });
+ObsReadAhead::ObsReadAhead(RinexObsHeader header, std::unique_ptr<Shared> shared, bool threaded)
+    : header_(std::move(header)), shared_(std::move(shared)), threaded_(threaded) {
+  if (threaded_) thread_ = std::thread([s = shared_.get()] { s->run(); });
 }
 
 ObsReadAhead::ObsReadAhead(ObsReadAhead&&) noexcept = default;
@@ -57,6 +59,7 @@ ObsReadAhead& ObsReadAhead::operator=(ObsReadAhead&& other) noexcept {
     header_ = std::move(other.header_);
     shared_ = std::move(other.shared_);
     thread_ = std::move(other.thread_);
+    threaded_ = other.threaded_;
     fraction_read_ = other.fraction_read_;
     warnings_returned_ = other.warnings_returned_;
   }
@@ -76,6 +79,13 @@ void ObsReadAhead::stop() {
 
 Result<std::optional<core::ObsEpoch>> ObsReadAhead::next() {
   if (shared_->ended) return std::optional<core::ObsEpoch>{};
+  if (!threaded_) {  // depth 0: parsed here, on the caller's thread
+    auto epoch = shared_->reader.next();
+    if (!epoch || !*epoch) shared_->ended = true;
+    fraction_read_ = shared_->reader.fraction_read();
+    warnings_returned_ = shared_->reader.warnings().size();
+    return epoch;
+  }
   std::optional<ObsReadAheadItem> item = shared_->queue.pop();
   if (!item) {
     shared_->ended = true;

@@ -51,17 +51,18 @@ std::vector<std::string> without_cpu_times(std::vector<std::string> lines) {
   return lines;
 }
 
-/// The layouts: one thread, six threads.
+/// The layouts: one thread, two (ingest and time bridge ahead), six threads.
 const std::vector<std::pair<std::string, PipelineOptions>>& layouts() {
   static const std::vector<std::pair<std::string, PipelineOptions>> all{
       {"sequential", PipelineOptions{false, 64}},
+      {"bridge-ahead", PipelineOptions{false, 4, true}},
       {"threaded", PipelineOptions{true, 4}},
   };
   return all;
 }
 
-/// Runs `config` in every layout; returns the sequential .pos file's contents and the others' (threaded) after
-/// checking that their counts and reports equal the sequential run's.
+/// Runs `config` in every layout; returns the sequential .pos file's contents and the others' (bridge-ahead,
+/// threaded) after checking that their counts and reports equal the sequential run's.
 std::pair<std::string, std::vector<std::string>> every_way(ProcessConfig config, const fs::path& dir) {
   std::optional<ProcessSummary> sequential;
   std::vector<std::string> others;
@@ -93,8 +94,9 @@ TEST(EpochPipeline, EveryLayoutEqualsSequentialRtkInstinct) {
   config->nav = {(data / "RINEX_GN_Spirent.23N").string()};
   const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  ASSERT_EQ(others.size(), 1U);
-  EXPECT_TRUE(seq == others[0]) << "threaded .pos differs from sequential";
+  ASSERT_EQ(others.size(), 2U);
+  EXPECT_TRUE(seq == others[0]) << "bridge-ahead .pos differs from sequential";
+  EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
 }
 
 TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
@@ -113,8 +115,9 @@ TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
   config->timesync = (dir / "timesync.csv").string();
   const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  ASSERT_EQ(others.size(), 1U);
-  EXPECT_TRUE(seq == others[0]) << "threaded .pos differs from sequential";
+  ASSERT_EQ(others.size(), 2U);
+  EXPECT_TRUE(seq == others[0]) << "bridge-ahead .pos differs from sequential";
+  EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
 }
 
 // ---- Queues and shutdown, with a fake source and estimator ----
@@ -179,8 +182,8 @@ class RecordingEstimator final : public EpochEstimator {
   std::atomic<bool> busy_{false};
 };
 
-TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
-  const PipelineOptions options{true, 1};
+void expect_full_queues_block_and_drop_nothing(const PipelineOptions& options) {
+  SCOPED_TRACE(options.threaded ? "threaded" : "bridge-ahead");
   CountingSource source(200, std::chrono::microseconds(0));
   RecordingEstimator estimator;
   std::vector<double> seen;
@@ -195,9 +198,16 @@ TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
   for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<double>(i));
   const PipelineStats stats = pipeline.stats();
   EXPECT_EQ(stats.epochs, 200U);
-  EXPECT_GT(stats.full_waits[0], 0U) << "ingest never found its queue full";
+  // Threaded: ingest's queue; bridge-ahead: the one queue, after the time bridge.
+  EXPECT_GT(stats.full_waits[options.threaded ? 0 : 1], 0U) << "the producer never found its queue full";
   EXPECT_TRUE(estimator.finished);
   for (const std::size_t depth : pipeline.queue_depths()) EXPECT_EQ(depth, 0U);
+}
+
+TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
+  for (const PipelineOptions& options : {PipelineOptions{true, 1}, PipelineOptions{false, 1, true}}) {
+    expect_full_queues_block_and_drop_nothing(options);
+  }
 }
 
 /// Counts the epochs between the time bridge and the ambiguity stage; add_navigation() must find none.
@@ -224,9 +234,9 @@ class InFlightEstimator final : public EpochEstimator {
 };
 
 // Ephemerides that arrive with an epoch are handed to the estimator once every earlier epoch has left the last
-// stage, in both modes, each once.
+// stage, in every layout, each once.
 TEST(EpochPipeline, EphemeridesAreAddedWhileNoStageRuns) {
-  for (const bool threaded : {true, false}) {
+  for (const auto& [name, options] : layouts()) {
     CountingSource counting(200, std::chrono::microseconds(0));
     struct WithNavigation final : EpochSource {
       explicit WithNavigation(CountingSource& s) : source(s) {}
@@ -249,10 +259,10 @@ TEST(EpochPipeline, EphemeridesAreAddedWhileNoStageRuns) {
           ++solved;
           return Ok{};
         },
-        PipelineOptions{threaded, 8});
-    ASSERT_TRUE(pipeline.run().ok());
-    EXPECT_EQ(solved, 200U) << threaded;
-    EXPECT_EQ(estimator.added, 40U) << threaded;  // 20 epochs with 2 records each
+        options);
+    ASSERT_TRUE(pipeline.run().ok()) << name;
+    EXPECT_EQ(solved, 200U) << name;
+    EXPECT_EQ(estimator.added, 40U) << name;  // 20 epochs with 2 records each
   }
 }
 
@@ -336,8 +346,8 @@ TEST(EpochPipeline, ObserverTakesThenHandsOnEachEpochOnItsStageThread) {
   }
 }
 
-TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {
-  const PipelineOptions options{true, 16};
+void expect_stop_finishes_the_epochs_in_flight(const PipelineOptions& options) {
+  SCOPED_TRACE(options.threaded ? "threaded" : "bridge-ahead");
   CountingSource source(-1, std::chrono::microseconds(50));  // endless
   RecordingEstimator estimator;
   std::atomic<int> sunk{0};
@@ -357,6 +367,12 @@ TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {
   EXPECT_GT(sunk.load(), 51) << "the epochs in the queues were not finished";
   EXPECT_EQ(sunk.load(), source.produced_.load()) << "an ingested epoch was lost at shutdown";
   EXPECT_TRUE(estimator.finished);
+}
+
+TEST(EpochPipeline, StopFinishesTheEpochsInFlight) {
+  for (const PipelineOptions& options : {PipelineOptions{true, 16}, PipelineOptions{false, 16, true}}) {
+    expect_stop_finishes_the_epochs_in_flight(options);
+  }
 }
 
 TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {

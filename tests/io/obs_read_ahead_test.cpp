@@ -1,4 +1,5 @@
-// ObsReadAhead against RinexObsReader: the same epochs, errors, warnings and progress, whatever the queue depth;
+// ObsReadAhead against RinexObsReader: the same epochs, errors, warnings and progress, whatever the queue depth (0:
+// no reading thread);
 // stopping early (a full queue, finish() half-way, destruction) neither hangs nor changes what was returned.
 
 #include "canyon/io/obs_read_ahead.hpp"
@@ -93,7 +94,7 @@ TEST(ObsReadAhead, GivesTheReadersEpochsAndProgressAtEveryDepth) {
   SKIP_WITHOUT_SHARED_DATA();
   const Reading expected = read_sequentially(kKinematicRover);
   ASSERT_EQ(expected.epochs.size(), 360U);
-  for (const std::size_t depth : {1U, 3U, 64U}) {
+  for (const std::size_t depth : {0U, 1U, 3U, 64U}) {  // 0: no reading thread
     SCOPED_TRACE("depth " + std::to_string(depth));
     expect_same(expected, read_ahead(kKinematicRover, depth));
   }
@@ -113,7 +114,7 @@ TEST(ObsReadAhead, CorruptEpochsGiveTheSameWarningsAndACutFileTheSameEnd) {
   const std::string path = dir.write("corrupt.21o", text);
   const Reading expected = read_sequentially(path);
   EXPECT_EQ(expected.warnings.size(), 3U);  // two corrupt epochs, the cut one
-  for (const std::size_t depth : {1U, 64U}) {
+  for (const std::size_t depth : {0U, 1U, 64U}) {
     SCOPED_TRACE("depth " + std::to_string(depth));
     expect_same(expected, read_ahead(path, depth));
   }
@@ -129,9 +130,12 @@ TEST(ObsReadAhead, FinishingHalfWayReportsOnlyTheWarningsOfTheEpochsReturned) {
   const std::string path = dir.write("late-warning.21o", text);
   // The reading thread is far ahead (depth 64) when the consumer stops after 250 epochs.
   const Reading expected = read_sequentially(path, 250);
-  const Reading actual = read_ahead(path, 64, 250);
-  EXPECT_TRUE(actual.warnings.empty());
-  expect_same(expected, actual);
+  for (const std::size_t depth : {0U, 64U}) {
+    SCOPED_TRACE("depth " + std::to_string(depth));
+    const Reading actual = read_ahead(path, depth, 250);
+    EXPECT_TRUE(actual.warnings.empty());
+    expect_same(expected, actual);
+  }
 }
 
 TEST(ObsReadAhead, DestroyedWithAFullQueueDoesNotHang) {

@@ -25,14 +25,16 @@ inline constexpr double kBaseToleranceS = 0.05;
 /// An observation file read epoch by epoch as observations: flag 6 epochs hold cycle-slip records (slip counts in
 /// the observation fields), not observations, and are dropped; after a power failure (flag 1) every phase may have
 /// slipped and gets the loss-of-lock bit. Streaming keeps memory flat however long the file is; a RINEX file is parsed
-/// ahead on a thread of its own (io::ObsReadAhead), which changes nothing but the wall time.
+/// ahead on a thread of its own (io::ObsReadAhead) unless `read_ahead` is false, which changes nothing but the wall
+/// time.
 class ObservationStream {
  public:
   /// A RINEX file; or, if `path` ends in .rtcm3 or .rtcm, a recorded RTCM 3 stream (`canyon record canyon/rtcm`)
   /// decoded as canyon rover decodes it from DDS, with weeks resolved against `reference` (any GPST within a few
   /// days of the data, e.g. the rover file's first epoch). An RTCM file's 1005/1006 gives the header's position.
   static Result<ObservationStream> open(const std::string& path, const io::ObsFilter& filter,
-                                        const std::optional<core::GpsTime>& reference = std::nullopt);
+                                        const std::optional<core::GpsTime>& reference = std::nullopt,
+                                        bool read_ahead = true);
 
   /// The next epoch of observations; nullopt at the end of the file.
   Result<std::optional<core::ObsEpoch>> next() {

@@ -29,6 +29,9 @@ class BatchQueue {
     pending_.push_back(std::move(item));
     return pending_.size() < batch_ || hand_over();
   }
+  /// Producer: hands over what is batched now, full batch or not (blocking while `depth` items wait). False if the
+  /// consumer has stopped.
+  bool flush() { return pending_.empty() || hand_over(); }
   /// Producer: hands over what is batched and marks the end of the items.
   void close() {
     hand_over();

@@ -24,7 +24,8 @@ class ObsReadAhead {
   static constexpr std::size_t kDefaultDepth = 32;
 
   /// Opens the file and reads its header on the calling thread (its errors are returned here), then starts the
-  /// reading thread.
+  /// reading thread. Depth 0: no reading thread, next() parses on the caller's thread (for a caller that already runs
+  /// on a thread of its own: on a 2-core machine a third busy thread only takes turns with the other two).
   static Result<ObsReadAhead> open(const std::string& path, std::optional<ObsFilter> filter = std::nullopt,
                                    std::size_t depth = kDefaultDepth);
 
@@ -48,13 +49,14 @@ class ObsReadAhead {
 
  private:
   struct Shared;
-  ObsReadAhead(RinexObsHeader header, std::unique_ptr<Shared> shared);
+  ObsReadAhead(RinexObsHeader header, std::unique_ptr<Shared> shared, bool threaded);
   void stop();
 
   RinexObsHeader header_;
   std::unique_ptr<Shared> shared_;
   double fraction_read_ = 0.0;
   std::size_t warnings_returned_ = 0;  // reader warnings up to the epoch next() returned last
+  bool threaded_ = true;               // false: depth 0, no reading thread
   std::thread thread_;
 };
 
