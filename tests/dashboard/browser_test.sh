@@ -59,6 +59,14 @@ load() {
   done
 }
 
+# The feed first: under ctest -j2 beside the heavy tests its start-up took long enough for every try of the first
+# load to find no snapshot yet (2026-11-25). Wait until the dashboard has some (60 s at most).
+snapshots() {
+  python3 -c "import urllib.request; print(urllib.request.urlopen('${url}metrics', timeout=5).read().decode())" \
+    2> /dev/null | sed -n 's/^canyon_dashboard_snapshots_total \([0-9]*\)/\1/p'
+}
+deadline=$((SECONDS + 60))
+until [[ "$(snapshots)" =~ ^[1-9] ]] || ((SECONDS >= deadline)); do sleep 0.2; done
 sleep 2
 load
 updates1="$(attr updates)"
