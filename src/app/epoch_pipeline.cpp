@@ -217,6 +217,19 @@ void EpochPipeline::ingested(EpochItem& item, std::uint64_t seq, std::int64_t en
   if (observer_.taken) observer_.taken(Stage::Ingest, item);
 }
 
+std::unique_ptr<EpochItem> EpochPipeline::ingest_next(std::uint64_t seq) {
+  const std::int64_t enter = monotonic_ns();
+  auto next = source_.next();
+  if (!next) {
+    fail(next.error());
+    return nullptr;
+  }
+  if (!*next) return nullptr;
+  auto item = std::make_unique<EpochItem>(std::move(**next));
+  ingested(*item, seq, enter);
+  return item;
+}
+
 void EpochPipeline::add_navigation(const EpochItem& item) {
   // Every earlier epoch has left the last stage (sequential: always so), then no stage reads the ephemerides.
   while (epochs_.load() < item.seq) std::this_thread::sleep_for(std::chrono::microseconds(50));
@@ -257,15 +270,8 @@ Status EpochPipeline::run_bridge_ahead() {
         to_free.swap(spent);
       }
       to_free.clear();
-      const std::int64_t enter = monotonic_ns();
-      auto next = source_.next();
-      if (!next) {
-        fail(next.error());
-        break;
-      }
-      if (!*next) break;
-      auto item = std::make_unique<EpochItem>(std::move(**next));
-      ingested(*item, seq, enter);
+      ItemPtr item = ingest_next(seq);
+      if (!item) break;
       // Fresh ephemerides wait for every earlier epoch to leave the last stage: those still batched must go first.
       if (item->navigation && !ready.flush()) break;
       run_stage(Stage::TimeBridge, *item);
@@ -311,15 +317,8 @@ Status EpochPipeline::run_threaded() {
   // Ingest.
   std::thread ingest([this, &push] {
     for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
-      const std::int64_t enter = monotonic_ns();
-      auto next = source_.next();
-      if (!next) {
-        fail(next.error());
-        break;
-      }
-      if (!*next) break;
-      auto item = std::make_unique<EpochItem>(std::move(**next));
-      ingested(*item, seq, enter);
+      ItemPtr item = ingest_next(seq);
+      if (!item) break;
       push(0, std::move(item));
       handed_on(Stage::Ingest);
     }

@@ -234,6 +234,9 @@ class EpochPipeline {
   Status run_threaded();
   /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
   void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
+  /// The ingest stage of the threaded layouts: the source's next epoch, stamped (ingested()); nullptr at the end of
+  /// the input, or after the source's error (recorded by fail()).
+  std::unique_ptr<EpochItem> ingest_next(std::uint64_t seq);
   void run_stage(Stage stage, EpochItem& item);
   void handed_on(Stage stage) const {
     if (observer_.handed_on) observer_.handed_on(stage);
