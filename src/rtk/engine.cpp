@@ -21,8 +21,7 @@ namespace {
 using core::Constellation;
 using core::SatelliteId;
 
-constexpr double kMaxBaseTimeAheadS = 0.05;  // base tags up to this much after the rover tag still count as "now"
-constexpr std::size_t kPrunedSubsets = 3;    // partial fixing prunes at most this many group-excluded subsets
+constexpr std::size_t kPrunedSubsets = 3;  // partial fixing prunes at most this many group-excluded subsets
 
 /// Wavelength of a satellite's first frequency (rank 0), the reference of the ionosphere state.
 double first_wavelength_m(const gnss::EphemerisStore& eph, SatelliteId sat) {
@@ -353,15 +352,13 @@ RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides
     : options_(std::move(options)),
       eph_(ephemerides),
       p_E_base_m_(std::move(p_E_base_m)),
-      geometry_builder_(geometry_options(), eph_, p_E_base_m_),
-      rover_slips_(options_.slips),
-      base_slips_(options_.slips) {
+      geometry_builder_(geometry_options(), eph_, p_E_base_m_) {
   x_ = Eigen::VectorXd::Zero(num_kinematic_states());
   P_ = Eigen::MatrixXd::Zero(num_kinematic_states(), num_kinematic_states());
 }
 
 EpochGeometryBuilder::Options RtkEngine::geometry_options() const {
-  return {options_.spp, options_.observables, options_.troposphere_saastamoinen};
+  return {options_.spp, options_.observables, options_.troposphere_saastamoinen, options_.slips, options_.max_age_s};
 }
 
 int RtkEngine::ambiguity_index(const AmbiguityKey& key) const {
@@ -514,17 +511,8 @@ void RtkEngine::revert_to_prior() {
   has_prior_ = false;
 }
 
-void RtkEngine::detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base) {
-  std::vector<SlipEvent> events = rover_slips_.update(rover);
-  if (!last_base_time_ || std::abs(base.time - *last_base_time_) > 1e-6) {
-    const std::vector<SlipEvent> base_events = base_slips_.update(base);
-    events.insert(events.end(), base_events.begin(), base_events.end());
-    last_base_time_ = base.time;
-  }
-  for (const SlipEvent& e : events) remove_ambiguity({e.sat, e.frequency});
-}
-
-void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t) {
+void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t, const SlipScan& slips) {
+  for (const SlipEvent& e : slips.events) remove_ambiguity({e.sat, e.frequency});
   // Remove ambiguities not seen for longer than the outage limit.
   std::vector<AmbiguityKey> stale;
   for (const auto& [key, info] : ambiguity_info_) {
@@ -549,9 +537,7 @@ void RtkEngine::update_ambiguities(std::vector<SingleDiff>& sds, const core::Gps
     AmbiguityInfo& a = ambiguity_info_[key];
     a.last_seen = t;
     ++a.lock_epochs;
-    const bool half_cycle = (sd.lli & core::kLliHalfCycle) != 0 ||
-                            rover_slips_.half_cycle_unresolved(sd.sat, sd.frequency) ||
-                            base_slips_.half_cycle_unresolved(sd.sat, sd.frequency);
+    const bool half_cycle = (sd.lli & core::kLliHalfCycle) != 0 || slips.half_cycle(sd.sat, sd.frequency);
     const bool glonass_ok = sd.sat.system != Constellation::Glonass || options_.glonass_ar;
     sd.fixable = !half_cycle && glonass_ok && a.lock_epochs > options_.min_lock_epochs &&
                  sd.elevation_rad >= options_.ar_elevation_mask_rad;
@@ -1111,12 +1097,18 @@ void RtkEngine::set_base_position(const Eigen::Vector3d& p_E_base_m) {
 
 Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding,
                                 EpochGeometry* geometry) {
-  // The epoch's geometry (single-point solution, observables, satellite states): built ahead by the caller, or here.
-  std::optional<EpochGeometry> own_geometry;
-  if (geometry == nullptr) geometry = &own_geometry.emplace(geometry_builder_.build(rover, base));
-  assert(geometry->has_base == (base != nullptr));
   has_prior_ = false;
   if (aiding != nullptr && !initialised_) aiding = nullptr;  // nothing to add the increment to yet
+  // The epoch's geometry (single-point solution, observables, satellite states, cycle slips): built ahead by the
+  // caller, or here.
+  std::optional<EpochGeometry> own_geometry;
+  if (geometry == nullptr) geometry = &own_geometry.emplace(geometry_builder_.build(rover, base, aiding != nullptr));
+  assert(geometry->has_base == (base != nullptr));
+  if (aiding != nullptr && !geometry->aided) {
+    return Error(
+        "rtk: an aided epoch's geometry was built ahead for an unaided one (no cycle-slip scan without a "
+        "single-point solution)");
+  }
   const Result<gnss::SppSolution>& spp = geometry->spp;
   if (!spp && aiding == nullptr) return spp.error();
 
@@ -1150,6 +1142,10 @@ Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoc
     return false;
   }
 
+  if (!geometry->slips) {
+    // A builder of other options than geometry_options() (a longer base age), or a geometry not from a builder.
+    return Error("rtk: the epoch's geometry has no cycle-slip scan (not built with the engine's geometry_options())");
+  }
   if (options_.ar_mode == ArMode::Instantaneous) clear_ambiguities();
   choose_ionosphere_model((sol.p_E_m - p_E_base_m_).norm());  // single-point position, or the aided prior
   if (aiding != nullptr) {
@@ -1157,9 +1153,8 @@ Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoc
   } else {
     time_update(rover.time, *spp);
   }
-  detect_slips(geometry->rover_obs, geometry->base_obs);
   pending_->sds = single_differences(*geometry);
-  update_ambiguities(pending_->sds, rover.time);
+  update_ambiguities(pending_->sds, rover.time, *geometry->slips);
   if (aiding != nullptr) {
     out.aided = true;
     out.prior_p_E_m = x_.head<3>();

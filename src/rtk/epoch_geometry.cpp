@@ -3,6 +3,7 @@
 #include "canyon/rtk/epoch_geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "canyon/core/constants.hpp"
 #include "canyon/gnss/atmosphere.hpp"
@@ -37,11 +38,40 @@ ZeroDiff EpochGeometry::base_model(const core::SatelliteId sat) const {
   return it != base_models.end() && it->first == sat ? it->second : ZeroDiff{};
 }
 
+bool SlipScan::half_cycle(const core::SatelliteId sat, const int frequency) const {
+  return std::binary_search(half_cycle_unresolved.begin(), half_cycle_unresolved.end(),
+                            CycleSlipDetector::Key{sat, frequency});
+}
+
 EpochGeometryBuilder::EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides,
                                            const Eigen::Vector3d& p_E_base_m)
-    : options_(std::move(options)), eph_(&ephemerides), base_(p_E_base_m) {}
+    : options_(std::move(options)),
+      eph_(&ephemerides),
+      base_(p_E_base_m),
+      rover_slips_(options_.slips),
+      base_slips_(options_.slips) {}
 
-EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+SlipScan EpochGeometryBuilder::scan_slips(const EpochGeometry& geometry) {
+  SlipScan scan;
+  scan.events = rover_slips_.update(geometry.rover_obs);
+  if (!last_base_time_ || std::abs(geometry.base_obs.time - *last_base_time_) > 1e-6) {
+    const std::vector<SlipEvent> base_events = base_slips_.update(geometry.base_obs);
+    scan.events.insert(scan.events.end(), base_events.begin(), base_events.end());
+    last_base_time_ = geometry.base_obs.time;
+  }
+  for (const SignalObservable& s : geometry.rover_obs.signals) {
+    if (rover_slips_.half_cycle_unresolved(s.sat, s.frequency) ||
+        base_slips_.half_cycle_unresolved(s.sat, s.frequency)) {
+      scan.half_cycle_unresolved.emplace_back(s.sat, s.frequency);
+    }
+  }
+  std::sort(scan.half_cycle_unresolved.begin(), scan.half_cycle_unresolved.end());
+  scan.half_cycle_unresolved.erase(std::unique(scan.half_cycle_unresolved.begin(), scan.half_cycle_unresolved.end()),
+                                   scan.half_cycle_unresolved.end());
+  return scan;
+}
+
+EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const core::ObsEpoch* base, bool aided) {
   gnss::EpochSatelliteStates rover_states(*eph_, rover.time);
   auto spp = gnss::solve_spp(rover, *eph_, options_.spp, last_spp_p_E_m_, &rover_states);
   if (spp) last_spp_p_E_m_ = spp->p_E_m;
@@ -50,7 +80,9 @@ EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const cor
                     select_observables(rover, *eph_, options_.observables),
                     base != nullptr,
                     {},
-                    {}};
+                    {},
+                    aided,
+                    std::nullopt};
   if (base == nullptr) return out;
   out.base_obs = select_observables(*base, *eph_, options_.observables);
   gnss::EpochSatelliteStates base_states(*eph_, out.base_obs.time);
@@ -62,6 +94,10 @@ EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const cor
     out.base_models.emplace_back(
         sat, zero_difference(base_states, sat, pseudorange_m, base_, options_.troposphere_saastamoinen));
   }
+  // The prediction's own conditions for going on to the single differences (RtkEngine::predict()).
+  const double age_s = rover.time - base->time;
+  const bool base_out_of_time = age_s > options_.max_base_age_s || age_s < -kMaxBaseTimeAheadS;
+  if (!base_out_of_time && (out.spp || aided)) out.slips = scan_slips(out);
   return out;
 }
 

@@ -35,8 +35,9 @@
 // its float solution and no fix is attempted.
 //
 // Cycle slips: each receiver's phases go through a CycleSlipDetector (loss of lock, half-cycle changes,
-// geometry-free jumps, Doppler against phase, outages); a slip at either receiver re-initialises the SD ambiguity,
-// and an unresolved half cycle at either receiver keeps it from being fixed.
+// geometry-free jumps, Doppler against phase, outages), owned by the geometry builder (rtk/epoch_geometry.hpp), which
+// may run on another thread; a slip at either receiver re-initialises the SD ambiguity, and an unresolved half cycle
+// at either receiver keeps it from being fixed.
 //
 // Time update: without dynamics (RTKLIB's "dynamics off") the position is re-initialised each epoch from the
 // single-point solution with a large variance; with dynamics a constant-acceleration model with white jerk.
@@ -236,10 +237,8 @@ class RtkEngine {
   /// The single differences of the epoch at the state's position (the rover's satellite states are added to the
   /// geometry's, shared with its single-point solution).
   [[nodiscard]] std::vector<SingleDiff> single_differences(EpochGeometry& geometry) const;
-  /// Runs both receivers' slip detectors and re-initialises the ambiguities that slipped; the base detector sees
-  /// each base epoch once (a base slower than the rover repeats its epochs).
-  void detect_slips(const ReceiverObservables& rover, const ReceiverObservables& base);
-  void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t);
+  /// Ambiguity bookkeeping: resets on the epoch's slips, removals after outages, new states, fixability.
+  void update_ambiguities(std::vector<SingleDiff>& sds, const core::GpsTime& t, const SlipScan& slips);
   /// A keyed state to append: initial value and variance, uncorrelated with the other states.
   struct NewState {
     AmbiguityKey key;
@@ -338,11 +337,8 @@ class RtkEngine {
   std::map<AmbiguityKey, AmbiguityInfo> ambiguity_info_;
   std::optional<core::GpsTime> last_time_;
   bool initialised_ = false;
-  EpochGeometryBuilder geometry_builder_;  // predict() without a geometry built ahead
-  CycleSlipDetector rover_slips_;
-  CycleSlipDetector base_slips_;
-  std::optional<core::GpsTime> last_base_time_;
-  std::map<DdKey, double> last_fix_;  // integers of the last accepted fix; pairs leave with their ambiguities
+  EpochGeometryBuilder geometry_builder_;  // predict() without a geometry built ahead (it owns the slip detectors)
+  std::map<DdKey, double> last_fix_;       // integers of the last accepted fix; pairs leave with their ambiguities
   // Aiding of the epoch being processed (nullptr otherwise), and the prior kept for revert_to_prior().
   const RtkAiding* aiding_ = nullptr;
   bool has_prior_ = false;

@@ -5,7 +5,9 @@
 // (app/epoch_pipeline.hpp), where it runs beside the filter's work on the epoch before.
 //
 // Each single-point solution starts from the one before it, a chain that the filter never touches: a builder fed
-// the same epochs in the same order gives the same geometry wherever it runs.
+// the same epochs in the same order gives the same geometry wherever it runs. The same holds for the cycle-slip
+// detectors of the two receivers (rtk/cycle_slip.hpp), which depend on the observations alone: the builder owns them
+// and scans each epoch that the engine goes on to use, so that the filter's thread does not spend its time on them.
 
 #include <optional>
 #include <utility>
@@ -20,9 +22,23 @@
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/gnss/satellite_states.hpp"
 #include "canyon/gnss/spp.hpp"
+#include "canyon/rtk/cycle_slip.hpp"
 #include "canyon/rtk/observables.hpp"
 
 namespace canyon::rtk {
+
+/// A base epoch tagged up to this much after the rover's still counts as simultaneous (s).
+inline constexpr double kMaxBaseTimeAheadS = 0.05;
+
+/// The cycle-slip scan of one epoch: both receivers' detectors fed with its observables.
+struct SlipScan {
+  std::vector<SlipEvent> events;  ///< the rover's, then the base's (the base is fed only when its epoch is new)
+  /// (satellite, frequency) pairs of the rover's signals whose latest phase at either receiver carries LLI bit 1
+  /// (half cycle unresolved), sorted.
+  std::vector<CycleSlipDetector::Key> half_cycle_unresolved;
+
+  [[nodiscard]] bool half_cycle(core::SatelliteId sat, int frequency) const;
+};
 
 /// Zero-difference model of one satellite seen from one receiver.
 struct ZeroDiff {
@@ -59,6 +75,11 @@ struct EpochGeometry {
   ReceiverObservables base_obs;  ///< empty without a base epoch
   /// Zero differences of the base's satellites that have a pseudorange, in base_obs order (ascending satellite).
   std::vector<std::pair<core::SatelliteId, ZeroDiff>> base_models;
+  /// Built for an aided prediction, which goes on without a single-point solution.
+  bool aided = false;
+  /// The cycle-slip scan, present when the prediction goes on to the single differences: a base epoch within the
+  /// age limits, and a single-point solution or aiding.
+  std::optional<SlipScan> slips;
 
   /// The base model of `sat`; an invalid one if the base has none.
   [[nodiscard]] ZeroDiff base_model(core::SatelliteId sat) const;
@@ -72,19 +93,27 @@ class EpochGeometryBuilder {
     gnss::SppOptions spp;
     ObservableOptions observables;
     bool troposphere_saastamoinen = true;  ///< in the zero differences
+    CycleSlipOptions slips;                ///< each receiver's cycle-slip detector
+    double max_base_age_s = 30.0;          ///< base epochs older than this are not used (no slip scan)
   };
   EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m);
 
   /// A new base position (RTCM 1005/1006 that arrived on a stream) for the epochs built from now on.
   void set_base_position(const Eigen::Vector3d& p_E_base_m) { base_ = ReceiverGeometry(p_E_base_m); }
-  /// The geometry of `rover` (and `base`, nullptr if none); continues the single-point chain when it solves.
-  [[nodiscard]] EpochGeometry build(const core::ObsEpoch& rover, const core::ObsEpoch* base);
+  /// The geometry of `rover` (and `base`, nullptr if none); continues the single-point chain when it solves, and
+  /// the slip detectors when the prediction goes on (EpochGeometry::slips). `aided`: the prediction is aided.
+  [[nodiscard]] EpochGeometry build(const core::ObsEpoch& rover, const core::ObsEpoch* base, bool aided = false);
 
  private:
   Options options_;
   const gnss::EphemerisStore* eph_;
   ReceiverGeometry base_;
   std::optional<Eigen::Vector3d> last_spp_p_E_m_;
+  CycleSlipDetector rover_slips_;
+  CycleSlipDetector base_slips_;
+  std::optional<core::GpsTime> last_base_time_;  // of the last base epoch fed to base_slips_
+
+  [[nodiscard]] SlipScan scan_slips(const EpochGeometry& geometry);
 };
 
 }  // namespace canyon::rtk

@@ -1,0 +1,153 @@
+// EpochGeometryBuilder owns the cycle-slip detectors of both receivers: it scans exactly the epochs the engine goes
+// on with, and an engine fed geometries built ahead gives the same epochs as one that builds its own.
+
+#include "canyon/rtk/epoch_geometry.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "canyon/gnss/ephemeris.hpp"
+#include "canyon/io/rinex_nav.hpp"
+#include "canyon/io/rinex_obs.hpp"
+#include "canyon/rtk/engine.hpp"
+
+namespace canyon::rtk {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kDir = fs::path(CANYON_SHARED_DATA_DIR) / "cssrlib-kinematic-doy265";
+const Eigen::Vector3d kBase_E_m{-3959400.631, 3385704.533, 3667523.111};  // the dataset's README
+
+struct Dataset {
+  io::RinexObsFile rover;
+  io::RinexObsFile base;
+  core::NavigationData nav;
+};
+
+std::optional<Dataset> load() {
+  auto rover = io::read_rinex_obs((kDir / "SEPT265G.21O").string());
+  auto base = io::read_rinex_obs((kDir / "3034265G.21O").string());
+  auto nav = io::read_rinex_nav((kDir / "SEPT2650.21P").string());
+  if (!rover || !base || !nav) {
+    ADD_FAILURE() << "cannot read the dataset in " << kDir;
+    return std::nullopt;
+  }
+  return Dataset{std::move(*rover), std::move(*base), std::move(nav->nav)};
+}
+
+/// The latest base epoch at or before the rover's (5 ms of tolerance for the dataset's offset tags), or nullptr.
+const core::ObsEpoch* base_for(const io::RinexObsFile& base, const core::ObsEpoch& rover) {
+  const core::ObsEpoch* out = nullptr;
+  for (const core::ObsEpoch& b : base.epochs) {
+    if (b.time - rover.time > 0.01) break;
+    out = &b;
+  }
+  return out;
+}
+
+#define SKIP_WITHOUT_DATA() \
+  if (!fs::exists(kDir)) GTEST_SKIP() << "shared dataset not present: " << kDir
+
+TEST(EpochGeometry, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
+  SKIP_WITHOUT_DATA();
+  const auto data = load();
+  ASSERT_TRUE(data);
+  const gnss::EphemerisStore eph(data->nav);
+  RtkOptions options;
+  options.ar_mode = ArMode::Continuous;
+  RtkEngine own(options, eph, kBase_E_m);
+  RtkEngine fed(options, eph, kBase_E_m);
+  EpochGeometryBuilder builder(fed.geometry_options(), eph, kBase_E_m);
+  // The scan against detectors fed here with the scanned epochs (the base's only when it is a new epoch).
+  CycleSlipDetector rover_slips(options.slips);
+  CycleSlipDetector base_slips(options.slips);
+  std::optional<core::GpsTime> last_base_time;
+  int rover_slip_events = 0;
+  int fixed = 0;
+  for (const core::ObsEpoch& rover : data->rover.epochs) {
+    const core::ObsEpoch* base = base_for(data->base, rover);
+    auto expected = own.process(rover, base);
+    EpochGeometry geometry = builder.build(rover, base);
+    if (geometry.slips) {
+      std::vector<SlipEvent> events = rover_slips.update(geometry.rover_obs);
+      rover_slip_events += static_cast<int>(events.size());
+      if (!last_base_time || std::abs(geometry.base_obs.time - *last_base_time) > 1e-6) {
+        const std::vector<SlipEvent> base_events = base_slips.update(geometry.base_obs);
+        events.insert(events.end(), base_events.begin(), base_events.end());
+        last_base_time = geometry.base_obs.time;
+      }
+      ASSERT_EQ(events.size(), geometry.slips->events.size()) << rover.time.tow_s;
+      for (std::size_t k = 0; k < events.size(); ++k) {
+        EXPECT_EQ(events[k].sat, geometry.slips->events[k].sat);
+        EXPECT_EQ(events[k].frequency, geometry.slips->events[k].frequency);
+        EXPECT_EQ(events[k].cause, geometry.slips->events[k].cause);
+      }
+      for (const SignalObservable& s : geometry.rover_obs.signals) {
+        EXPECT_EQ(rover_slips.half_cycle_unresolved(s.sat, s.frequency) ||
+                      base_slips.half_cycle_unresolved(s.sat, s.frequency),
+                  geometry.slips->half_cycle(s.sat, s.frequency));
+      }
+    }
+    auto more = fed.predict(rover, base, nullptr, &geometry);
+    ASSERT_EQ(static_cast<bool>(expected), static_cast<bool>(more)) << rover.time.tow_s;
+    if (!more) continue;
+    if (*more && fed.update()) fed.resolve();
+    const RtkEpoch got = fed.take_epoch();
+    ASSERT_EQ(expected->solution.status, got.solution.status) << rover.time.tow_s;
+    EXPECT_EQ(expected->solution.p_E_m, got.solution.p_E_m) << rover.time.tow_s;
+    EXPECT_EQ(expected->num_fixed_ambiguities, got.num_fixed_ambiguities) << rover.time.tow_s;
+    if (got.solution.status == core::SolutionStatus::Fixed) ++fixed;
+  }
+  EXPECT_GT(rover_slip_events, 0) << "the rover file has slips: the scan must see them";
+  EXPECT_GT(fixed, 0);
+}
+
+TEST(EpochGeometry, ScansOnlyTheEpochsThePredictionGoesOnWith) {
+  SKIP_WITHOUT_DATA();
+  const auto data = load();
+  ASSERT_TRUE(data);
+  const gnss::EphemerisStore eph(data->nav);
+  const RtkEngine engine(RtkOptions{}, eph, kBase_E_m);
+  EpochGeometryBuilder builder(engine.geometry_options(), eph, kBase_E_m);
+  const core::ObsEpoch& first = data->rover.epochs.front();
+  const core::ObsEpoch& later = data->rover.epochs.back();
+  ASSERT_GT(later.time - first.time, RtkOptions{}.max_age_s);
+
+  EXPECT_FALSE(builder.build(first, nullptr).slips) << "no base";
+  EXPECT_FALSE(builder.build(later, base_for(data->base, first)).slips) << "a base older than max_age_s";
+  const EpochGeometry with_base = builder.build(first, base_for(data->base, first));
+  ASSERT_TRUE(with_base.spp);
+  EXPECT_TRUE(with_base.slips);
+  core::ObsEpoch without_signals = first;
+  without_signals.sats.clear();
+  const EpochGeometry no_spp = builder.build(without_signals, base_for(data->base, first));
+  EXPECT_FALSE(no_spp.spp);
+  EXPECT_FALSE(no_spp.slips) << "no single-point solution, not aided";
+  EXPECT_TRUE(builder.build(without_signals, base_for(data->base, first), true).slips) << "aided";
+}
+
+TEST(EpochGeometry, AGeometryWithoutItsSlipScanIsAnError) {
+  SKIP_WITHOUT_DATA();
+  const auto data = load();
+  ASSERT_TRUE(data);
+  const gnss::EphemerisStore eph(data->nav);
+  RtkEngine engine(RtkOptions{}, eph, kBase_E_m);
+  EpochGeometryBuilder::Options other = engine.geometry_options();
+  other.max_base_age_s = -1.0;  // scans nothing
+  EpochGeometryBuilder builder(other, eph, kBase_E_m);
+  const core::ObsEpoch& rover = data->rover.epochs.front();
+  const core::ObsEpoch* base = base_for(data->base, rover);
+  EpochGeometry geometry = builder.build(rover, base);
+  const auto result = engine.predict(rover, base, nullptr, &geometry);
+  ASSERT_FALSE(result);
+  EXPECT_NE(result.error().message.find("cycle-slip scan"), std::string::npos) << result.error().message;
+}
+
+}  // namespace
+}  // namespace canyon::rtk
