@@ -802,12 +802,16 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
   fix.Q_a = 0.5 * (fix.Q_a + fix.Q_a.transpose()).eval();
   CarriedDecorrelation& carried = carried_decorrelations_[dd_keys(dd)];
   carried.last_epoch = ar_epoch_;
-  auto search = mlambda(fix.a_float, fix.Q_a, MlambdaOptions{}, &carried.warm);
+  MlambdaOptions search_options;
+  search_options.with_z = true;  // for success_rate_subset_fix()
+  auto search = mlambda(fix.a_float, fix.Q_a, search_options, &carried.warm);
   if (!search) return std::nullopt;
   fix.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
   fix.squared_norm = search->squared_norms[0];
   fix.success_rate = bootstrap_success_rate(search->conditional_variances);
   fix.a_fix = search->candidates.col(0);
+  fix.Z = std::move(search->Z);
+  fix.d = std::move(search->conditional_variances);
   return fix;
 }
 
@@ -920,20 +924,19 @@ bool RtkEngine::better_fix(const Fix& l, const Fix& r) {
 
 std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full, int min_size) const {
   const auto n = full.a_float.size();
-  auto dec = decorrelate(full.Q_a);
-  if (!dec) return std::nullopt;
+  if (full.Z.rows() != n || full.d.size() != n) return std::nullopt;
   // Longest trailing run of levels whose bootstrapped success rate stays at or above the threshold.
   double success = 1.0;
   Eigen::Index k0 = n;
   while (k0 > 0) {
-    const double with_next = success * bootstrap_success_rate(dec->d.segment(k0 - 1, 1));
+    const double with_next = success * bootstrap_success_rate(full.d.segment(k0 - 1, 1));
     if (with_next < options_.min_success_rate) break;
     success = with_next;
     --k0;
   }
   const Eigen::Index m = n - k0;
   if (m == n || m < std::max(min_size, options_.min_fix_ambiguities)) return std::nullopt;
-  const Eigen::MatrixXd Z_S = dec->Z.rightCols(m);
+  const Eigen::MatrixXd Z_S = full.Z.rightCols(m);
   Fix sub;
   sub.dd = full.dd;
   sub.combinations = true;

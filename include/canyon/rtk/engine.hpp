@@ -264,8 +264,10 @@ class RtkEngine {
     Eigen::MatrixXd PDt;    // P D^T
     Eigen::VectorXd a_fix;  // best integer candidate
     double ratio = 0.0;
-    double squared_norm = 0.0;              // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
-    double success_rate = 0.0;              // bootstrapped success rate of the float model
+    double squared_norm = 0.0;  // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
+    double success_rate = 0.0;  // bootstrapped success rate of the float model
+    Eigen::MatrixXd Z;          // the search's decorrelation: Z^T Q_a Z = L^T diag(d) L
+    Eigen::VectorXd d;
     std::vector<core::SatelliteId> pruned;  // satellites pruned by their ILS residual to get this set
     // The fixed quantities are integer combinations Z_S^T of the DD ambiguities dd (a_float = Z_S^T D x, PDt = P D^T
     // Z_S) rather than the DD ambiguities themselves: a partial fix by the success rate.
@@ -275,12 +277,12 @@ class RtkEngine {
   /// MLAMBDA on a set of DD ambiguities; nullopt if the set has fewer than max(min_size, min_fix_ambiguities).
   [[nodiscard]] std::optional<Fix> try_fix(const std::vector<std::pair<int, int>>& dd, int min_size) const;
   /// Partial fixing by the success rate (Teunissen's partial ambiguity resolution): in the decorrelated space
-  /// z = Z^T a of the full set, Q_z = L^T D L, the trailing levels k0..n-1 form a problem of their own (their
-  /// factors are the trailing blocks of L and D) whose bootstrapped success rate is prod_{k >= k0} p_k. Fixes the
-  /// largest such trailing set whose success rate reaches min_success_rate, if it has at least
-  /// max(min_size, min_fix_ambiguities) members and passes the ratio test; nullopt otherwise. Fix::imprecise is set
-  /// when the position it leaves has a 3D sigma above max_partial_fix_sigma_m (then it is no fix, but the float
-  /// position conditioned on it is still the better float).
+  /// z = Z^T a of the full set's search (Fix::Z), Q_z = L^T D L, the trailing levels k0..n-1 form a problem of their
+  /// own (their factors are the trailing blocks of L and D) whose bootstrapped success rate is prod_{k >= k0} p_k.
+  /// Fixes the largest such trailing set whose success rate reaches min_success_rate, if it has at least max(min_size,
+  /// min_fix_ambiguities) members and passes the ratio test; nullopt otherwise. Fix::imprecise is set when the position
+  /// it leaves has a 3D sigma above max_partial_fix_sigma_m (then it is no fix, but the float position conditioned on
+  /// it is still the better float).
   [[nodiscard]] std::optional<Fix> success_rate_subset_fix(const Fix& full, int min_size) const;
   /// Ratio test, success rate and agreement with the last fix (and the aiding's accept_fix when aided).
   [[nodiscard]] bool accepted(const Fix& fix) const;
