@@ -139,7 +139,7 @@ class EpochEstimator {
 };
 
 /// RTK (rtk::RtkEngine): no VIO and no alignment; the time bridge builds each epoch's geometry (single-point
-/// solution, observables, satellite states: rtk/epoch_geometry.hpp) ahead of the filter.
+/// solution, observables, satellite states, cycle-slip scan: rtk/epoch_geometry.hpp) ahead of the filter.
 class RtkEstimator final : public EpochEstimator {
  public:
   explicit RtkEstimator(rtk::RtkEngine& engine)
