@@ -449,8 +449,13 @@ Result<IntegerSearchResult> solve_integer_least_squares(const Eigen::VectorXd& a
   Status decorrelated = Ok{};
   if (warm != nullptr) {
     if (from_warm) {
-      a_centred = warm->Z.transpose() * a_centred;                          // a' = Z_0^T (a_float - shift)
-      const Eigen::MatrixXd Q_start = warm->Z.transpose() * Q_a * warm->Z;  // symmetrised by the factorisation
+      a_centred = warm->Z.transpose() * a_centred;  // a' = Z_0^T (a_float - shift)
+      // Z_0^T Q_a Z_0, symmetric: the lower triangle of Z_0^T (Q_a Z_0) (three quarters of the two full products),
+      // mirrored.
+      const Eigen::MatrixXd Q_Z = Q_a * warm->Z;
+      Eigen::MatrixXd Q_start(Q_a.rows(), Q_a.cols());
+      Q_start.triangularView<Eigen::Lower>() = warm->Z.transpose() * Q_Z;
+      Q_start.triangularView<Eigen::StrictlyUpper>() = Q_start.transpose();
       decorrelated = decorrelate_into(Q_start, dec, true, true, &z_hat, &a_centred, &perm, nullptr, warm);
     } else {
       decorrelated = decorrelate_into(Q_a, dec, true, true, &z_hat, &a_centred, &perm, nullptr);
