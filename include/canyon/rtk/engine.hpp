@@ -264,10 +264,10 @@ class RtkEngine {
     Eigen::MatrixXd PDt;    // P D^T
     Eigen::VectorXd a_fix;  // best integer candidate
     double ratio = 0.0;
-    double squared_norm = 0.0;  // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
-    double success_rate = 0.0;  // bootstrapped success rate of the float model
-    Eigen::MatrixXd Z;          // the search's decorrelation: Z^T Q_a Z = L^T diag(d) L
-    Eigen::VectorXd d;
+    double squared_norm = 0.0;              // (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
+    double success_rate = 0.0;              // bootstrapped success rate of the float model
+    Eigen::MatrixXd Z;                      // the search's decorrelation: Z^T Q_a Z = L^T diag(d) L
+    Eigen::VectorXd d;                      // its conditional variances (cycles^2)
     std::vector<core::SatelliteId> pruned;  // satellites pruned by their ILS residual to get this set
     // The fixed quantities are integer combinations Z_S^T of the DD ambiguities dd (a_float = Z_S^T D x, PDt = P D^T
     // Z_S) rather than the DD ambiguities themselves: a partial fix by the success rate.
