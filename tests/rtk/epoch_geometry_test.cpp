@@ -41,7 +41,7 @@ std::optional<Dataset> load() {
   return Dataset{std::move(*rover), std::move(*base), std::move(nav->nav)};
 }
 
-/// The latest base epoch at or before the rover's (5 ms of tolerance for the dataset's offset tags), or nullptr.
+/// The latest base epoch tagged at most 10 ms after the rover's (the dataset's tags are 5 ms apart), or nullptr.
 const core::ObsEpoch* base_for(const io::RinexObsFile& base, const core::ObsEpoch& rover) {
   const core::ObsEpoch* out = nullptr;
   for (const core::ObsEpoch& b : base.epochs) {
