@@ -1107,11 +1107,6 @@ Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoc
   std::optional<EpochGeometry> own_geometry;
   if (geometry == nullptr) geometry = &own_geometry.emplace(geometry_builder_.build(rover, base, aiding != nullptr));
   assert(geometry->has_base == (base != nullptr));
-  if (aiding != nullptr && !geometry->aided) {
-    return Error(
-        "rtk: an aided epoch's geometry was built ahead for an unaided one (no cycle-slip scan without a "
-        "single-point solution)");
-  }
   const Result<gnss::SppSolution>& spp = geometry->spp;
   if (!spp && aiding == nullptr) return spp.error();
 
@@ -1140,13 +1135,14 @@ Result<bool> RtkEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoc
   }
   const double age_s = rover.time - base->time;
   sol.age_s = age_s;
-  if (age_s > options_.max_age_s || age_s < -kMaxBaseTimeAheadS) {
+  if (base_out_of_time(age_s, options_.max_age_s)) {
     out.note = "base observations too old (age " + std::to_string(age_s) + " s)";
     return false;
   }
 
   if (!geometry->slips) {
-    // A builder of other options than geometry_options() (a longer base age), or a geometry not from a builder.
+    // A builder of other options than geometry_options() (a longer base age), a geometry built ahead unaided for an
+    // aided epoch without a single point, or a geometry not from a builder.
     return Error("rtk: the epoch's geometry has no cycle-slip scan (not built with the engine's geometry_options())");
   }
   if (options_.ar_mode == ArMode::Instantaneous) clear_ambiguities();

@@ -81,7 +81,6 @@ EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const cor
                     base != nullptr,
                     {},
                     {},
-                    aided,
                     std::nullopt};
   if (base == nullptr) return out;
   out.base_obs = select_observables(*base, *eph_, options_.observables);
@@ -95,9 +94,9 @@ EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const cor
         sat, zero_difference(base_states, sat, pseudorange_m, base_, options_.troposphere_saastamoinen));
   }
   // The prediction's own conditions for going on to the single differences (RtkEngine::predict()).
-  const double age_s = rover.time - base->time;
-  const bool base_out_of_time = age_s > options_.max_base_age_s || age_s < -kMaxBaseTimeAheadS;
-  if (!base_out_of_time && (out.spp || aided)) out.slips = scan_slips(out);
+  if (!base_out_of_time(rover.time - base->time, options_.max_base_age_s) && (out.spp || aided)) {
+    out.slips = scan_slips(out);
+  }
   return out;
 }
 

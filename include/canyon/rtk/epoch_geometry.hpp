@@ -30,6 +30,12 @@ namespace canyon::rtk {
 /// A base epoch tagged up to this much after the rover's still counts as simultaneous (s).
 inline constexpr double kMaxBaseTimeAheadS = 0.05;
 
+/// True if a base epoch `age_s` older than the rover's is not used: older than `max_age_s`, or ahead of it by more
+/// than kMaxBaseTimeAheadS (the rule of RtkEngine::predict() and of the builder's slip scan).
+[[nodiscard]] inline bool base_out_of_time(double age_s, double max_age_s) {
+  return age_s > max_age_s || age_s < -kMaxBaseTimeAheadS;
+}
+
 /// The cycle-slip scan of one epoch: both receivers' detectors fed with its observables.
 struct SlipScan {
   std::vector<SlipEvent> events;  ///< the rover's, then the base's (the base is fed only when its epoch is new)
@@ -75,8 +81,6 @@ struct EpochGeometry {
   ReceiverObservables base_obs;  ///< empty without a base epoch
   /// Zero differences of the base's satellites that have a pseudorange, in base_obs order (ascending satellite).
   std::vector<std::pair<core::SatelliteId, ZeroDiff>> base_models;
-  /// Built for an aided prediction, which goes on without a single-point solution.
-  bool aided = false;
   /// The cycle-slip scan, present when the prediction goes on to the single differences: a base epoch within the
   /// age limits, and a single-point solution or aiding.
   std::optional<SlipScan> slips;
