@@ -71,6 +71,28 @@ SlipScan EpochGeometryBuilder::scan_slips(const EpochGeometry& geometry) {
   return scan;
 }
 
+const EpochGeometryBuilder::BaseSide& EpochGeometryBuilder::base_side(const core::ObsEpoch& base) {
+  if (base_cache_ && base_cache_->time == base.time && base_cache_->num_satellites == base.sats.size() &&
+      base_cache_->ephemeris_stamp == eph_->selection_stamp()) {
+    return *base_cache_;
+  }
+  BaseSide& side = base_cache_.emplace();
+  side.time = base.time;
+  side.num_satellites = base.sats.size();
+  side.ephemeris_stamp = eph_->selection_stamp();
+  side.obs = select_observables(base, *eph_, options_.observables);
+  gnss::EpochSatelliteStates states(*eph_, side.obs.time);
+  for (std::size_t i = 0; i < side.obs.signals.size(); ++i) {
+    const core::SatelliteId sat = side.obs.signals[i].sat;
+    if (i > 0 && side.obs.signals[i - 1].sat == sat) continue;  // signals are grouped by satellite
+    const double pseudorange_m = any_pseudorange(side.obs, sat);
+    if (!core::has_value(pseudorange_m)) continue;
+    side.models.emplace_back(sat,
+                             zero_difference(states, sat, pseudorange_m, base_, options_.troposphere_saastamoinen));
+  }
+  return side;
+}
+
 EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const core::ObsEpoch* base, bool aided) {
   gnss::EpochSatelliteStates rover_states(*eph_, rover.time);
   auto spp = gnss::solve_spp(rover, *eph_, options_.spp, last_spp_p_E_m_, &rover_states);
@@ -83,16 +105,9 @@ EpochGeometry EpochGeometryBuilder::build(const core::ObsEpoch& rover, const cor
                     {},
                     std::nullopt};
   if (base == nullptr) return out;
-  out.base_obs = select_observables(*base, *eph_, options_.observables);
-  gnss::EpochSatelliteStates base_states(*eph_, out.base_obs.time);
-  for (std::size_t i = 0; i < out.base_obs.signals.size(); ++i) {
-    const core::SatelliteId sat = out.base_obs.signals[i].sat;
-    if (i > 0 && out.base_obs.signals[i - 1].sat == sat) continue;  // signals are grouped by satellite
-    const double pseudorange_m = any_pseudorange(out.base_obs, sat);
-    if (!core::has_value(pseudorange_m)) continue;
-    out.base_models.emplace_back(
-        sat, zero_difference(base_states, sat, pseudorange_m, base_, options_.troposphere_saastamoinen));
-  }
+  const BaseSide& side = base_side(*base);
+  out.base_obs = side.obs;
+  out.base_models = side.models;
   // The prediction's own conditions for going on to the single differences (RtkEngine::predict()).
   if (!base_out_of_time(rover.time - base->time, options_.max_base_age_s) && (out.spp || aided)) {
     out.slips = scan_slips(out);

@@ -1,8 +1,10 @@
 // EpochGeometryBuilder owns the cycle-slip detectors of both receivers: it scans exactly the epochs the engine goes
-// on with, and an engine fed geometries built ahead gives the same epochs as one that builds its own.
+// on with, and an engine fed geometries built ahead gives the same epochs as one that builds its own. A base epoch
+// that serves several rover epochs keeps its zero differences until the base position or the ephemerides change.
 
 #include "canyon/rtk/epoch_geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -147,6 +149,55 @@ TEST(EpochGeometry, AGeometryWithoutItsSlipScanIsAnError) {
   const auto result = engine.predict(rover, base, nullptr, &geometry);
   ASSERT_FALSE(result);
   EXPECT_NE(result.error().message.find("cycle-slip scan"), std::string::npos) << result.error().message;
+}
+
+/// The builder's base side equals that of a builder that never saw an epoch before (nothing cached).
+void expect_base_side_as_built_alone(const EpochGeometry& got, const EpochGeometryBuilder::Options& options,
+                                     const gnss::EphemerisStore& eph, const Eigen::Vector3d& p_E_base_m,
+                                     const core::ObsEpoch& rover, const core::ObsEpoch* base) {
+  EpochGeometryBuilder alone(options, eph, p_E_base_m);
+  const EpochGeometry expected = alone.build(rover, base);
+  ASSERT_EQ(expected.base_obs.signals.size(), got.base_obs.signals.size());
+  ASSERT_EQ(expected.base_models.size(), got.base_models.size());
+  for (std::size_t k = 0; k < got.base_models.size(); ++k) {
+    EXPECT_EQ(expected.base_models[k].first, got.base_models[k].first);
+    EXPECT_EQ(expected.base_models[k].second.valid, got.base_models[k].second.valid);
+    EXPECT_EQ(expected.base_models[k].second.model_m, got.base_models[k].second.model_m);
+    EXPECT_EQ(expected.base_models[k].second.los_E, got.base_models[k].second.los_E);
+  }
+}
+
+TEST(EpochGeometry, ABaseEpochServingSeveralRoverEpochsKeepsItsModelsUntilThePositionOrEphemeridesChange) {
+  SKIP_WITHOUT_DATA();
+  const auto data = load();
+  ASSERT_TRUE(data);
+  const core::ObsEpoch* base = base_for(data->base, data->rover.epochs.front());
+  ASSERT_NE(base, nullptr);
+  // A store without the ephemerides of the base's first GPS satellite, which arrive later (add()).
+  const auto gps = std::find_if(base->sats.begin(), base->sats.end(),
+                                [](const core::SatelliteObs& s) { return s.sat.system == core::Constellation::Gps; });
+  ASSERT_NE(gps, base->sats.end());
+  const core::SatelliteId missing = gps->sat;
+  core::NavigationData partial = data->nav;
+  std::erase_if(partial.kepler, [&](const core::KeplerEphemeris& e) { return e.sat == missing; });
+  gnss::EphemerisStore eph(partial);
+  const RtkEngine engine(RtkOptions{}, eph, kBase_E_m);
+  const EpochGeometryBuilder::Options options = engine.geometry_options();
+  EpochGeometryBuilder builder(options, eph, kBase_E_m);
+  const auto model_of = [&](const EpochGeometry& g) { return g.base_model(missing); };
+  for (std::size_t k = 0; k < 3; ++k) {  // one base epoch, three rover epochs
+    const EpochGeometry g = builder.build(data->rover.epochs[k], base);
+    expect_base_side_as_built_alone(g, options, eph, kBase_E_m, data->rover.epochs[k], base);
+    EXPECT_FALSE(model_of(g).valid) << "no ephemeris for " << missing.to_string() << " yet";
+  }
+  const Eigen::Vector3d moved = kBase_E_m + Eigen::Vector3d(10.0, -5.0, 3.0);
+  builder.set_base_position(moved);
+  const EpochGeometry after_move = builder.build(data->rover.epochs[3], base);
+  expect_base_side_as_built_alone(after_move, options, eph, moved, data->rover.epochs[3], base);
+  ASSERT_GT(eph.add(data->nav), 0);
+  const EpochGeometry after_add = builder.build(data->rover.epochs[4], base);
+  expect_base_side_as_built_alone(after_add, options, eph, moved, data->rover.epochs[4], base);
+  EXPECT_TRUE(model_of(after_add).valid) << "the new ephemerides reach the base epoch already seen";
 }
 
 }  // namespace

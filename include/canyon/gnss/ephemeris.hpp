@@ -88,6 +88,9 @@ class EphemerisStore {
   /// files' ephemerides changes no selection. The number of records added. Not thread-safe: no other thread may read
   /// the store meanwhile (pointers from select_*() stay valid only until the next add()).
   int add(const core::NavigationData& fresh);
+  /// Changes whenever add() adds a record (and only then): a cache of states computed from this store is still valid
+  /// while it is unchanged.
+  [[nodiscard]] std::uint64_t selection_stamp() const { return selection_stamp_; }
 
  private:
   void index_kepler(int i);

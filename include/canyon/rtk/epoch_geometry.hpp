@@ -9,6 +9,7 @@
 // detectors of the two receivers (rtk/cycle_slip.hpp), which depend on the observations alone: the builder owns them
 // and scans each epoch that the engine goes on to use, so that the filter's thread does not spend its time on them.
 
+#include <cstdint>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -103,7 +104,10 @@ class EpochGeometryBuilder {
   EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m);
 
   /// A new base position (RTCM 1005/1006 that arrived on a stream) for the epochs built from now on.
-  void set_base_position(const Eigen::Vector3d& p_E_base_m) { base_ = ReceiverGeometry(p_E_base_m); }
+  void set_base_position(const Eigen::Vector3d& p_E_base_m) {
+    base_ = ReceiverGeometry(p_E_base_m);
+    base_cache_.reset();
+  }
   /// The geometry of `rover` (and `base`, nullptr if none); continues the single-point chain when it solves, and
   /// the slip detectors when the prediction goes on (EpochGeometry::slips). `aided`: the prediction is aided.
   [[nodiscard]] EpochGeometry build(const core::ObsEpoch& rover, const core::ObsEpoch* base, bool aided = false);
@@ -116,6 +120,19 @@ class EpochGeometryBuilder {
   CycleSlipDetector rover_slips_;
   CycleSlipDetector base_slips_;
   std::optional<core::GpsTime> last_base_time_;  // of the last base epoch fed to base_slips_
+  // The base side of the last epoch built: a base epoch serves several rover epochs (a 1 Hz base and a 5 Hz rover),
+  // and its observables and zero differences depend on it, the base position and the ephemerides alone.
+  struct BaseSide {
+    core::GpsTime time;
+    std::size_t num_satellites;
+    std::uint64_t ephemeris_stamp;  // gnss::EphemerisStore::selection_stamp()
+    ReceiverObservables obs;
+    std::vector<std::pair<core::SatelliteId, ZeroDiff>> models;
+  };
+  std::optional<BaseSide> base_cache_;
+
+  /// The base side of `base`: from base_cache_ if it is that epoch's, else computed (and cached).
+  [[nodiscard]] const BaseSide& base_side(const core::ObsEpoch& base);
 
   [[nodiscard]] SlipScan scan_slips(const EpochGeometry& geometry);
 };
