@@ -92,6 +92,8 @@ void RtkEstimator::resolve(EpochItem& item) {
 }
 
 void FusionEstimator::bridge(EpochItem& item) const {
+  if (item.base_position_E_m) geometry_.set_base_position(*item.base_position_E_m);
+  item.fusion_geometry.emplace(geometry_.build(item.rover, item.base ? &*item.base : nullptr));
   if (live_vio_ != nullptr) live_vio_->await(item.rover.time);
   item.pose = engine_.bridge(item.rover.time);
 }
@@ -103,7 +105,8 @@ void FusionEstimator::align(EpochItem& item) {
 void FusionEstimator::predict(EpochItem& item) {
   if (item.base_position_E_m) engine_.set_base_position(*item.base_position_E_m);
   const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
-  record_prediction(item, engine_.predict(item.rover, base, item.pose));
+  record_prediction(
+      item, engine_.predict(item.rover, base, item.pose, item.fusion_geometry ? &*item.fusion_geometry : nullptr));
 }
 
 void FusionEstimator::update(EpochItem& item) {

@@ -7,7 +7,6 @@
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
-#include "canyon/gnss/satellite_states.hpp"
 
 namespace canyon::fusion {
 namespace {
@@ -54,10 +53,14 @@ double Cn0Screen::level_dbhz(core::Constellation system, char band, double eleva
 
 int Cn0Screen::apply(core::ObsEpoch& epoch, const gnss::EphemerisStore& ephemerides,
                      const Eigen::Vector3d& p_E_approx_m) {
+  gnss::EpochSatelliteStates states(ephemerides, epoch.time);
+  return apply(epoch, states, p_E_approx_m);
+}
+
+int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, const Eigen::Vector3d& p_E_approx_m) {
   if (!options_.enabled) return 0;
   const core::Geodetic g = core::ecef_to_geodetic(p_E_approx_m);
   const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
-  gnss::EpochSatelliteStates states(ephemerides, epoch.time);
   struct Seen {
     core::Constellation system;
     char band;

@@ -94,8 +94,8 @@ FusionEngine::FusionEngine(FusionOptions options, const rtk::RtkOptions& rtk_opt
     : options_(std::move(options)),
       rtk_options_(rtk_options),
       ephemerides_(ephemerides),
-      cn0_screen_(options_.cn0),
       engine_(rtk_options, ephemerides, p_E_base_m),
+      geometry_builder_(make_geometry_builder()),
       track_(std::move(track)),
       t_IA_m_(options_.lever_arm_prior_m) {}
 
@@ -228,31 +228,29 @@ void FusionEngine::flush_alignment() {
 }
 
 Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsEpoch* base,
-                                   const std::optional<VioPoseAt>& pose) {
+                                   const std::optional<VioPoseAt>& pose, FusionGeometry* geometry) {
   epoch_time_ = rover.time;
   epoch_pose_ = pose;
   guard_rejections_epoch_ = 0;
   undetermined_fixes_epoch_ = 0;
   aiding_ = make_aiding(rover.time, pose);
-  // The C/N0 screen learns from every epoch but screens only aided ones: before the VIO is aligned the RTK engine
-  // needs every signal it can get for the solutions the alignment starts from.
-  core::ObsEpoch screened;
-  const core::ObsEpoch* observed = &rover;
-  if (options_.cn0.enabled && engine_.has_position()) {
-    screened = rover;
-    const Eigen::Vector3d p_approx = prior_ ? prior_->p_E_m : engine_.position_E_m();
-    const int removed = cn0_screen_.apply(screened, ephemerides_, p_approx);
-    if (aiding_) {
-      stats_.cn0_screened += removed;
-      observed = &screened;
-    }
+  std::optional<FusionGeometry> own_geometry;
+  if (geometry == nullptr) geometry = &own_geometry.emplace(geometry_builder_.build(rover, base));
+  if (aiding_ && geometry->screened_rover_obs) {
+    stats_.cn0_screened += geometry->screened;
+    geometry->rtk.rover_obs = std::move(*geometry->screened_rover_obs);
+    geometry->screened_rover_obs.reset();
   }
-  auto more = engine_.predict(*observed, base, aiding_ ? &*aiding_ : nullptr);
+  auto more = engine_.predict(rover, base, aiding_ ? &*aiding_ : nullptr, &geometry->rtk);
   if (!more) {
     count_fix_rejections();
     pending_alignment_ = PendingAlignment{rover.time, pose};
   }
   return more;
+}
+
+FusionGeometryBuilder FusionEngine::make_geometry_builder() const {
+  return FusionGeometryBuilder(engine_.geometry_options(), options_.cn0, ephemerides_, engine_.base_position_E_m());
 }
 
 bool FusionEngine::update() {

@@ -1,6 +1,7 @@
 // The fusion's units: time bridge (jitter, drift, outliers), VIO track (interpolation, segments), the increment's
 // covariance (Eqs. 4-6) against the simulator's VIO errors over many seeds, the Jacobians against numeric
-// differences, alignment and lever-arm calibration on synthetic data, the PCA gate, the C/N0 screen.
+// differences, alignment and lever-arm calibration on synthetic data, the PCA gate, the C/N0 screen, the epoch geometry
+// built ahead of the engine.
 
 #include <cmath>
 #include <filesystem>
@@ -14,6 +15,8 @@
 #include "canyon/core/geodesy.hpp"
 #include "canyon/fusion/alignment.hpp"
 #include "canyon/fusion/cn0_screen.hpp"
+#include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/fusion/fusion_geometry.hpp"
 #include "canyon/fusion/time_bridge.hpp"
 #include "canyon/fusion/vio_prediction.hpp"
 #include "canyon/fusion/vio_track.hpp"
@@ -453,6 +456,61 @@ TEST(Cn0ScreenTest, RemovesTheNlosSignalsOfAStreetCanyonAndKeepsTheLineOfSightOn
   EXPECT_LT(los_removed, 0.05 * los);
   std::printf("C/N0 screen: %d of %d NLOS signals removed, %d of %d line-of-sight ones\n", nlos_removed, nlos,
               los_removed, los);
+}
+
+// --- Epoch geometry built ahead -------------------------------------------------------------------------------------
+
+TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
+  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/urban-severe.yaml").string());
+  ASSERT_TRUE(scenario.ok()) << scenario.error().to_string();
+  scenario->duration_s = 120.0;
+  const fs::path dir = fs::temp_directory_path() / ("canyon_fusion_geometry_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto sim = sim::simulate(*scenario, (dir / "nav.rnx").string());
+  fs::remove_all(dir);
+  ASSERT_TRUE(sim.ok()) << sim.error().to_string();
+  const gnss::EphemerisStore eph(sim->nav);
+  std::vector<VioTrackSample> samples;
+  for (const sim::VioSample& v : sim->vio.poses) {
+    VioTrackSample t;
+    t.t_s = v.time - scenario->start;
+    t.T_OI = v.T_OI;
+    t.P = v.covariance;
+    t.C_previous = v.cross_previous;
+    samples.push_back(t);
+  }
+  rtk::RtkOptions rtk_options;
+  rtk_options.ionosphere = rtk::IonosphereModel::Estimate;
+  const FusionOptions options;
+  const VioTrack track = VioTrack::from_samples(samples, scenario->start);
+  FusionEngine own(options, rtk_options, eph, sim->base_p_E_m, track);
+  FusionEngine fed(options, rtk_options, eph, sim->base_p_E_m, track);
+  FusionGeometryBuilder builder = fed.make_geometry_builder();
+  std::size_t base = 0;
+  int aided = 0;
+  int screened = 0;
+  for (const core::ObsEpoch& e : sim->rover.epochs) {
+    while (base + 1 < sim->base.epochs.size() && sim->base.epochs[base + 1].time - e.time <= 0.05) ++base;
+    const core::ObsEpoch* b = &sim->base.epochs[base];
+    auto expected = own.process(e, b);
+    FusionGeometry geometry = builder.build(e, b);
+    screened += geometry.screened;
+    const auto pose = fed.bridge(e.time);
+    fed.align(e.time, pose);
+    auto more = fed.predict(e, b, pose, &geometry);
+    ASSERT_EQ(static_cast<bool>(expected), static_cast<bool>(more)) << e.time.tow_s;
+    if (!more) continue;
+    if (*more && fed.update()) fed.resolve();
+    const FusionEpoch got = fed.finish_epoch();
+    fed.flush_alignment();
+    ASSERT_EQ(expected->solution.status, got.solution.status) << e.time.tow_s;
+    EXPECT_EQ(expected->solution.p_E_m, got.solution.p_E_m) << e.time.tow_s;
+    if (got.aided) ++aided;
+  }
+  EXPECT_EQ(own.stats().cn0_screened, fed.stats().cn0_screened);
+  EXPECT_GT(fed.stats().cn0_screened, 0) << "the screen must have removed signals of aided epochs";
+  EXPECT_GT(screened, fed.stats().cn0_screened) << "its verdicts on unaided epochs are not applied";
+  EXPECT_GT(aided, 0);
 }
 
 }  // namespace

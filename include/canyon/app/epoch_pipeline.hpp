@@ -43,6 +43,7 @@
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
 #include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/fusion/fusion_geometry.hpp"
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/rtk/engine.hpp"
 
@@ -106,10 +107,11 @@ struct EpochItem {
   std::array<std::int64_t, kNumStages> exit_ns{};
   std::optional<fusion::VioPoseAt> pose;       ///< time bridge (fusion)
   std::optional<rtk::EpochGeometry> geometry;  ///< time bridge (rtk): the epoch's filter-independent geometry
-  bool to_update = false;                      ///< prediction's verdict: the epoch goes on to the update
-  bool to_resolve = false;                     ///< update's verdict: the epoch goes on to ambiguity resolution
-  std::optional<Error> error;                  ///< no solution at all (the reason)
-  std::optional<EpochOutput> output;           ///< the solution (after the ambiguity stage)
+  std::optional<fusion::FusionGeometry> fusion_geometry;  ///< time bridge (fusion): the same with the C/N0 screen
+  bool to_update = false;                                 ///< prediction's verdict: the epoch goes on to the update
+  bool to_resolve = false;            ///< update's verdict: the epoch goes on to ambiguity resolution
+  std::optional<Error> error;         ///< no solution at all (the reason)
+  std::optional<EpochOutput> output;  ///< the solution (after the ambiguity stage)
 };
 
 /// Where epochs come from (the ingest stage): a rover epoch with its base epoch.
@@ -159,12 +161,13 @@ class RtkEstimator final : public EpochEstimator {
 
 class LiveVio;
 
-/// The paper's fusion (fusion::FusionEngine). With a live VIO stream (app/live_vio.hpp) the time bridge first waits
-/// for the VIO to cover the epoch.
+/// The paper's fusion (fusion::FusionEngine). The time bridge builds each epoch's geometry (fusion/fusion_geometry.hpp)
+/// ahead of the filter, then takes its VIO pose; with a live VIO stream (app/live_vio.hpp) it waits for the VIO to
+/// cover the epoch.
 class FusionEstimator final : public EpochEstimator {
  public:
   explicit FusionEstimator(fusion::FusionEngine& engine, LiveVio* live_vio = nullptr)
-      : engine_(engine), live_vio_(live_vio) {}
+      : engine_(engine), live_vio_(live_vio), geometry_(engine.make_geometry_builder()) {}
   void bridge(EpochItem& item) const override;
   void align(EpochItem& item) override;
   void predict(EpochItem& item) override;
@@ -175,6 +178,8 @@ class FusionEstimator final : public EpochEstimator {
  private:
   fusion::FusionEngine& engine_;
   LiveVio* live_vio_;
+  // The bridge's own builder: bridge() runs on one thread, epoch after epoch (const for the interface's sake).
+  mutable fusion::FusionGeometryBuilder geometry_;
 };
 
 /// Receives each epoch after its last stage (on the ambiguity stage's thread); an error stops the pipeline.

@@ -19,6 +19,7 @@
 
 #include "canyon/core/observation.hpp"
 #include "canyon/gnss/ephemeris.hpp"
+#include "canyon/gnss/satellite_states.hpp"
 
 namespace canyon::fusion {
 
@@ -39,6 +40,8 @@ class Cn0Screen {
   /// Removes the suspected NLOS signals from `epoch` (a satellite left without signals is removed), then learns from
   /// the epoch's signals. Returns the number of signals removed.
   int apply(core::ObsEpoch& epoch, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_approx_m);
+  /// The same with the satellite states of the epoch's reception time (shared with other users of the epoch).
+  int apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, const Eigen::Vector3d& p_E_approx_m);
 
   /// The learnt line-of-sight level (dB-Hz) of a bin, or a negative value if it has too few samples.
   [[nodiscard]] double level_dbhz(core::Constellation system, char band, double elevation_rad) const;

@@ -18,7 +18,8 @@
 //     the VIO incremental motion, at least min_gate_m; applied to phase only: DD code noise is of that size) and/or
 //     DD phase and code innovations beyond gate_sigmas sqrt(h P h^T + r) (chi-square gate).
 //  Beyond the paper, before all that, the C/N0 screen (cn0_screen.hpp) removes suspected NLOS signals of aided epochs
-//  (it learns from all: before the alignment the RTK engine needs every signal for the solutions it aligns with).
+//  (it learns from all: before the alignment the RTK engine needs every signal for the solutions it aligns with); it
+//  runs with the epoch's geometry (fusion_geometry.hpp), which the pipeline builds ahead of the filter.
 //  5. Float validation: at least one DD phase used; the largest DD post-fit residual, over the RTK engine's rejection
 //     threshold, <= max_post_fit_normalised; the float position consistent with the prior,
 //     (p_float - p_prior)^T P_prior^-1 (p_float - p_prior) <= max_prior_chi2. If it fails: the update is undone and
@@ -49,6 +50,7 @@
 #include "canyon/core/solution.hpp"
 #include "canyon/fusion/alignment.hpp"
 #include "canyon/fusion/cn0_screen.hpp"
+#include "canyon/fusion/fusion_geometry.hpp"
 #include "canyon/fusion/time_bridge.hpp"
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/gnss/ephemeris.hpp"
@@ -167,9 +169,15 @@ class FusionEngine {
   [[nodiscard]] std::optional<VioPoseAt> bridge(const core::GpsTime& t) const;
   /// Alignment: the pending alignment of the previous epoch (T_EO, t_IA), then this epoch's VIO segment bookkeeping.
   void align(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
-  /// Prediction: the VIO increment (Eqs. 3-6) as the RTK engine's aiding, the C/N0 screen, the RTK engine's
-  /// prediction (rtk::RtkEngine::predict). Error as process(); true if the epoch goes on to update().
-  Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const std::optional<VioPoseAt>& pose);
+  /// Prediction: the VIO increment (Eqs. 3-6) as the RTK engine's aiding, the C/N0 screen's verdict on an aided
+  /// epoch, the RTK engine's prediction (rtk::RtkEngine::predict). `geometry`: the epoch's geometry built ahead by a
+  /// builder from make_geometry_builder() that saw every epoch before this one (nullptr: the engine builds it; do not
+  /// mix the two in one run); the prediction may move its observables. Error as process(); true if the epoch goes on
+  /// to update().
+  Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const std::optional<VioPoseAt>& pose,
+                       FusionGeometry* geometry = nullptr);
+  /// A builder of the engine's epoch geometry (fusion_geometry.hpp), to run ahead of predict().
+  [[nodiscard]] FusionGeometryBuilder make_geometry_builder() const;
   /// Update: the RTK engine's gated measurement update; true if the epoch goes on to resolve().
   bool update();
   /// Ambiguity resolution: the RTK engine's MLAMBDA with pruning and the false-fix guard.
@@ -188,7 +196,10 @@ class FusionEngine {
   /// The track has the poses that make bridge(t) final (VioTrack::covers).
   [[nodiscard]] bool vio_covers(const core::GpsTime& t) const;
   /// The base position from the next epoch on (rtk::RtkEngine::set_base_position).
-  void set_base_position(const Eigen::Vector3d& p_E_base_m) { engine_.set_base_position(p_E_base_m); }
+  void set_base_position(const Eigen::Vector3d& p_E_base_m) {
+    engine_.set_base_position(p_E_base_m);
+    geometry_builder_.set_base_position(p_E_base_m);
+  }
   /// The lever arm t_IA in use (the prior until calibrated) (m, IMU frame).
   [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return t_IA_m_; }
 
@@ -233,8 +244,8 @@ class FusionEngine {
   FusionOptions options_;
   rtk::RtkOptions rtk_options_;
   const gnss::EphemerisStore& ephemerides_;
-  Cn0Screen cn0_screen_;
   rtk::RtkEngine engine_;
+  FusionGeometryBuilder geometry_builder_;  // predict() without a geometry built ahead
   VioTrack track_;
   mutable std::shared_mutex track_mutex_;  // see add_vio()
   std::optional<Alignment> alignment_;
