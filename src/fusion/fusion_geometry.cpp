@@ -9,7 +9,9 @@ namespace canyon::fusion {
 FusionGeometryBuilder::FusionGeometryBuilder(const rtk::EpochGeometryBuilder::Options& options,
                                              const Cn0ScreenOptions& cn0, const gnss::EphemerisStore& ephemerides,
                                              const Eigen::Vector3d& p_E_base_m)
-    : observables_(options.observables), eph_(&ephemerides), rtk_(options, ephemerides, p_E_base_m),
+    : observables_(options.observables),
+      eph_(&ephemerides),
+      rtk_(options, ephemerides, p_E_base_m),
       screen_(cn0),
       screening_(cn0.enabled) {}
 

@@ -5,15 +5,17 @@
 // order, so they give the same solutions (tests/app/epoch_pipeline_test).
 //
 //   ingest ──▶ time bridge ──▶ alignment ──▶ prediction ──▶ update ──▶ ambiguity resolution ──▶ sink
-//      │  rover epoch + base   VIO pose at    pending T_EO /  VIO increment  gated DD EKF   MLAMBDA, ratio, pruning,
-//      │  epoch (BaseCursor    the epoch's    t_IA fit, VIO   as aiding, RTK  (RtkEngine::  float validation, fill-in,
-//      │  or DDS), stamped     GPST (track    segment book-   time update,    update)       output (finish_epoch)
-//      │  on arrival           on GPST)       keeping         single diffs
+//      │  rover epoch + base   epoch geometry pending T_EO /  VIO increment  gated DD EKF   MLAMBDA, ratio, pruning,
+//      │  epoch (BaseCursor    (+ C/N0), VIO  t_IA fit, VIO   as aiding, RTK  (RtkEngine::  float validation, fill-in,
+//      │  or DDS), stamped     pose at the    segment book-   time update,    update)       output (finish_epoch)
+//      │  on arrival           epoch's GPST   keeping         single diffs
 //
 // What each stage does is the engine's own code (rtk::RtkEngine and fusion::FusionEngine expose their stages; see
-// their headers); rtk mode has no VIO: its time bridge and alignment stages pass epochs through.
+// their headers); rtk mode has no VIO: its time bridge builds the epoch's geometry only, its alignment stage passes
+// epochs through.
 //
-// Honest about the parallelism: ingest (file parsing, base matching) and the time bridge (read-only VIO track) run
+// Honest about the parallelism: ingest (file parsing, base matching) and the time bridge (the epoch's geometry:
+// satellite states, single point, base zero differences, slip scan, C/N0 screen; the read-only VIO track) run
 // ahead freely. Alignment, prediction, update and ambiguity resolution share one estimator state and epoch k+1's
 // alignment needs epoch k's solution (the filter is recursive), so a token returned by the last stage admits one
 // epoch at a time into the alignment stage: those four stages overlap with ingest and the time bridge but not with
