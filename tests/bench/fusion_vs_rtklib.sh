@@ -75,9 +75,10 @@ timed() {
 }
 # median FILE: "wall_s cpu_s", each the median of its column in FILE (lines of "wall_s cpu_s").
 median() {
-  sort -n -k1,1 "$1" | awk '{w[NR] = $1} END {print w[int((NR + 1) / 2)]}' >"$1.w"
-  sort -n -k2,2 "$1" | awk '{c[NR] = $2} END {print c[int((NR + 1) / 2)]}' >"$1.c"
-  paste -d ' ' "$1.w" "$1.c"
+  local column
+  for column in 1 2; do
+    cut -d ' ' -f "$column" "$1" | sort -n | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'
+  done | paste -d ' ' - -
 }
 # speed DIR: rnx2rtkp and canyon fusion timed SPEED_RUNS times (default 5) on DIR's files, one after the other in
 # turn (the machine's speed drifts from minute to minute: both see the same drift); writes the medians to

@@ -5,7 +5,11 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -85,6 +89,20 @@ TEST(TimeBridgeTest, GpsClockStampsMapDirectly) {
 }
 
 // --- VIO track ------------------------------------------------------------------------------------------------------
+
+/// The simulator's VIO poses as track samples, timed from `start`.
+std::vector<VioTrackSample> track_samples(const std::vector<sim::VioSample>& poses, const core::GpsTime& start) {
+  std::vector<VioTrackSample> samples;
+  for (const sim::VioSample& v : poses) {
+    VioTrackSample t;
+    t.t_s = v.time - start;
+    t.T_OI = v.T_OI;
+    t.P = v.covariance;
+    t.C_previous = v.cross_previous;
+    samples.push_back(t);
+  }
+  return samples;
+}
 
 std::vector<VioTrackSample> straight_samples(int n, double dt_s, double speed_mps) {
   std::vector<VioTrackSample> s(static_cast<std::size_t>(n));
@@ -233,15 +251,7 @@ TEST(VioPredictionTest, IncrementCovarianceMatchesTheSimulatedVioErrorsOverSeeds
   std::vector<double> sums(cases.size(), 0.0);
   for (int seed = 1; seed <= kSeeds; ++seed) {
     const sim::VioRun run = sim::simulate_vio(s, walk, static_cast<std::uint64_t>(seed));
-    std::vector<VioTrackSample> samples;
-    for (const sim::VioSample& v : run.poses) {
-      VioTrackSample t;
-      t.t_s = v.time - s.start;
-      t.T_OI = v.T_OI;
-      t.P = v.covariance;
-      t.C_previous = v.cross_previous;
-      samples.push_back(t);
-    }
+    const std::vector<VioTrackSample> samples = track_samples(run.poses, s.start);
     std::vector<VioTrackSample> truth = samples;
     for (std::size_t k = 0; k < truth.size(); ++k) truth[k].T_OI = run.poses[k].T_OI_true;
     const VioTrack track = VioTrack::from_samples(samples, s.start);
@@ -422,19 +432,42 @@ TEST(AlignmentTest, CoarseYawFromMetreLevelSolutions) {
   EXPECT_GT(coarse->spread_m, 10.0);
 }
 
+// --- Simulated street canyon ---------------------------------------------------------------------------------------
+
+struct Simulated {
+  sim::Scenario scenario;
+  sim::Simulation sim;
+};
+
+/// The shipped urban-severe scenario cut to `duration_s`, simulated (its navigation file written to a temporary
+/// folder named after `tag`, removed again); nullopt after a test failure.
+std::optional<Simulated> simulate_urban_severe(double duration_s, const std::string& tag,
+                                               const sim::SimulationOptions& options = {}) {
+  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/urban-severe.yaml").string());
+  if (!scenario) {
+    ADD_FAILURE() << scenario.error().to_string();
+    return std::nullopt;
+  }
+  scenario->duration_s = duration_s;
+  const fs::path dir = fs::temp_directory_path() / ("canyon_" + tag + "_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto sim = sim::simulate(*scenario, (dir / "nav.rnx").string(), options);
+  fs::remove_all(dir);
+  if (!sim) {
+    ADD_FAILURE() << sim.error().to_string();
+    return std::nullopt;
+  }
+  return Simulated{std::move(*scenario), std::move(*sim)};
+}
+
 // --- C/N0 screen ----------------------------------------------------------------------------------------------------
 
 TEST(Cn0ScreenTest, RemovesTheNlosSignalsOfAStreetCanyonAndKeepsTheLineOfSightOnes) {
-  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/urban-severe.yaml").string());
-  ASSERT_TRUE(scenario.ok()) << scenario.error().to_string();
-  scenario->duration_s = 60.0;
-  const fs::path dir = fs::temp_directory_path() / ("canyon_cn0_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
   sim::SimulationOptions options;
   options.keep_signal_truth = true;
-  auto sim = sim::simulate(*scenario, (dir / "nav.rnx").string(), options);
-  fs::remove_all(dir);
-  ASSERT_TRUE(sim.ok()) << sim.error().to_string();
+  auto simulated = simulate_urban_severe(60.0, "cn0", options);
+  ASSERT_TRUE(simulated);
+  const sim::Simulation* sim = &simulated->sim;
   const gnss::EphemerisStore eph(sim->nav);
   Cn0Screen screen(Cn0ScreenOptions{});
   int nlos = 0, nlos_removed = 0, los = 0, los_removed = 0;
@@ -461,28 +494,15 @@ TEST(Cn0ScreenTest, RemovesTheNlosSignalsOfAStreetCanyonAndKeepsTheLineOfSightOn
 // --- Epoch geometry built ahead -------------------------------------------------------------------------------------
 
 TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
-  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/urban-severe.yaml").string());
-  ASSERT_TRUE(scenario.ok()) << scenario.error().to_string();
-  scenario->duration_s = 120.0;
-  const fs::path dir = fs::temp_directory_path() / ("canyon_fusion_geometry_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  auto sim = sim::simulate(*scenario, (dir / "nav.rnx").string());
-  fs::remove_all(dir);
-  ASSERT_TRUE(sim.ok()) << sim.error().to_string();
+  auto simulated = simulate_urban_severe(120.0, "fusion_geometry");
+  ASSERT_TRUE(simulated);
+  const sim::Simulation* sim = &simulated->sim;
   const gnss::EphemerisStore eph(sim->nav);
-  std::vector<VioTrackSample> samples;
-  for (const sim::VioSample& v : sim->vio.poses) {
-    VioTrackSample t;
-    t.t_s = v.time - scenario->start;
-    t.T_OI = v.T_OI;
-    t.P = v.covariance;
-    t.C_previous = v.cross_previous;
-    samples.push_back(t);
-  }
   rtk::RtkOptions rtk_options;
   rtk_options.ionosphere = rtk::IonosphereModel::Estimate;
   const FusionOptions options;
-  const VioTrack track = VioTrack::from_samples(samples, scenario->start);
+  const VioTrack track =
+      VioTrack::from_samples(track_samples(sim->vio.poses, simulated->scenario.start), simulated->scenario.start);
   FusionEngine own(options, rtk_options, eph, sim->base_p_E_m, track);
   FusionEngine fed(options, rtk_options, eph, sim->base_p_E_m, track);
   FusionGeometryBuilder builder = fed.make_geometry_builder();

@@ -43,6 +43,8 @@ class Cn0Screen {
   /// The same with the satellite states of the epoch's reception time (shared with other users of the epoch).
   int apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, const Eigen::Vector3d& p_E_approx_m);
 
+  /// Whether the screen removes anything (Cn0ScreenOptions::enabled).
+  [[nodiscard]] bool enabled() const { return options_.enabled; }
   /// The learnt line-of-sight level (dB-Hz) of a bin, or a negative value if it has too few samples.
   [[nodiscard]] double level_dbhz(core::Constellation system, char band, double elevation_rad) const;
 

@@ -45,11 +45,8 @@ class FusionGeometryBuilder {
   [[nodiscard]] FusionGeometry build(const core::ObsEpoch& rover, const core::ObsEpoch* base);
 
  private:
-  rtk::ObservableOptions observables_;
-  const gnss::EphemerisStore* eph_;
   rtk::EpochGeometryBuilder rtk_;
   Cn0Screen screen_;
-  bool screening_;
   std::optional<Eigen::Vector3d> p_E_approx_m_;  // the latest single-point position
 };
 

@@ -103,6 +103,8 @@ class EpochGeometryBuilder {
   };
   EpochGeometryBuilder(Options options, const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m);
 
+  [[nodiscard]] const Options& options() const { return options_; }
+  [[nodiscard]] const gnss::EphemerisStore& ephemerides() const { return *eph_; }
   /// A new base position (RTCM 1005/1006 that arrived on a stream) for the epochs built from now on.
   void set_base_position(const Eigen::Vector3d& p_E_base_m) {
     base_ = ReceiverGeometry(p_E_base_m);
