@@ -174,6 +174,9 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("coarse_window_s", o.coarse_window_s);
   map.get("coarse_min_spread_m", o.coarse_min_spread_m);
   map.get("coarse_max_yaw_sigma_deg", o.coarse_max_yaw_sigma_deg);
+  map.get("heading_state", o.heading_state);
+  map.get("heading_random_walk_deg_per_sqrt_km", o.heading_random_walk_deg_per_sqrt_km);
+  map.get("fine_heading_sigma_deg", o.fine_heading_sigma_deg);
   std::string prediction = fusion::prediction_name(o.prediction);
   map.get("prediction", prediction);
   if (prediction == "vio") {
@@ -436,6 +439,9 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("coarse_window_s") << o.coarse_window_s;
   key("coarse_min_spread_m") << o.coarse_min_spread_m;
   key("coarse_max_yaw_sigma_deg") << o.coarse_max_yaw_sigma_deg;
+  key("heading_state") << o.heading_state;
+  key("heading_random_walk_deg_per_sqrt_km") << o.heading_random_walk_deg_per_sqrt_km;
+  key("fine_heading_sigma_deg") << o.fine_heading_sigma_deg;
   key("prediction") << fusion::prediction_name(o.prediction);
   key("vio_covariance") << o.vio_covariance;
   key("constant_increment_sigma_m") << o.constant_increment_sigma_m;

@@ -74,6 +74,9 @@ std::string FusionOptions::validate() const {
   if (!(coarse_window_s > 0.0) || !(coarse_min_spread_m > 0.0) || !(coarse_max_yaw_sigma_deg > 0.0)) {
     return "coarse_window_s, coarse_min_spread_m and coarse_max_yaw_sigma_deg must be > 0";
   }
+  if (!(heading_random_walk_deg_per_sqrt_km >= 0.0) || !(fine_heading_sigma_deg > 0.0)) {
+    return "heading_random_walk_deg_per_sqrt_km must be >= 0 and fine_heading_sigma_deg > 0";
+  }
   if (!(constant_increment_sigma_m > 0.0)) return "constant_increment_sigma_m must be > 0";
   if (!(gate_motion_factor > 0.0) || !(min_gate_m > 0.0) || !(gate_sigmas > 0.0)) {
     return "gate_motion_factor, min_gate_m and gate_sigmas must be > 0";
@@ -89,12 +92,22 @@ std::string FusionOptions::validate() const {
   return {};
 }
 
+namespace {
+
+/// The RTK engine's options with the heading error state when the fusion estimates it.
+rtk::RtkOptions with_heading_state(rtk::RtkOptions rtk_options, const FusionOptions& options) {
+  rtk_options.aiding_heading_state = options.heading_state && options.prediction == Prediction::Vio;
+  return rtk_options;
+}
+
+}  // namespace
+
 FusionEngine::FusionEngine(FusionOptions options, const rtk::RtkOptions& rtk_options,
                            const gnss::EphemerisStore& ephemerides, const Eigen::Vector3d& p_E_base_m, VioTrack track)
     : options_(std::move(options)),
       rtk_options_(rtk_options),
       ephemerides_(ephemerides),
-      engine_(rtk_options, ephemerides, p_E_base_m),
+      engine_(with_heading_state(rtk_options, options_), ephemerides, p_E_base_m),
       geometry_builder_(make_geometry_builder()),
       track_(std::move(track)),
       t_IA_m_(options_.lever_arm_prior_m) {}
@@ -112,9 +125,19 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
     if (!before || before->segment != pose->segment || pose->segment != alignment_->segment) return std::nullopt;
     const Eigen::Vector3d up_E =
         core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_state)).row(2).transpose();  // local vertical
-    const VioIncrement inc = vio_increment(before->T_OI, pose->T_OI, track_.joint_covariance(*before, *pose), t_IA_m_,
-                                           alignment_->T_EO.rotation(), alignment_->yaw_sigma_rad, up_E);
+    const bool heading_state = options_.heading_state;
+    const VioIncrement inc =
+        vio_increment(before->T_OI, pose->T_OI, track_.joint_covariance(*before, *pose), t_IA_m_,
+                      alignment_->T_EO.rotation(), heading_state ? 0.0 : alignment_->yaw_sigma_rad, up_E);
     aiding.delta_p_E_m = inc.dp_E_m;
+    if (heading_state) {
+      const double walk_rad = options_.heading_random_walk_deg_per_sqrt_km * core::kDegToRad;
+      aiding.dp_d_heading_E_m = up_E.cross(inc.dp_E_m);
+      aiding.heading_noise_rad2 = walk_rad * walk_rad * inc.dp_E_m.norm() / 1000.0;
+      aiding.heading_variance_rad2 = alignment_->heading_sigma_rad * alignment_->heading_sigma_rad;
+      aiding.restart_heading = !alignment_->heading_started;
+      alignment_->heading_started = true;
+    }
     if (options_.vio_covariance) {
       aiding.Q_E_m2 = inc.cov_E_m2;
     } else {
@@ -330,6 +353,7 @@ FusionEpoch FusionEngine::finish_epoch() {
     ++stats_.fallback;
   }
   if (out.solution.status == core::SolutionStatus::Fixed) ++stats_.fixed;
+  if (out.aided) fold_heading_error();
   out.rejected = result->rejected;
   out.ar_pruned = result->ar_pruned;
   out.rtk = epoch;
@@ -349,6 +373,20 @@ FusionEpoch FusionEngine::finish_epoch() {
   }
   pending_alignment_ = PendingAlignment{epoch_time_, pose};
   return out;
+}
+
+void FusionEngine::fold_heading_error() {
+  if (!options_.heading_state || !alignment_) return;
+  const std::optional<rtk::RtkEngine::HeadingError> heading = engine_.take_heading_error();
+  if (!heading) return;
+  const Eigen::Vector3d p_E_m = engine_.position_E_m();
+  const Eigen::Vector3d up_E = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_E_m)).row(2).transpose();
+  const Eigen::Quaterniond q_psi(Eigen::AngleAxisd(heading->psi_rad, up_E));
+  core::Pose& T_EO = alignment_->T_EO;
+  T_EO = core::Pose{(q_psi * T_EO.q).normalized(), q_psi * (T_EO.p - p_E_m) + p_E_m};
+  alignment_->heading_sigma_rad = std::sqrt(heading->variance_rad2);
+  stats_.heading_folded_rad += heading->psi_rad;
+  stats_.heading_sigma_rad = alignment_->heading_sigma_rad;
 }
 
 std::vector<AlignmentPoint> FusionEngine::window(const core::GpsTime& t, double span_s, int segment,
@@ -395,7 +433,7 @@ void FusionEngine::update_alignment(const core::GpsTime& t, const std::optional<
           t_IA_m_ = fit->t_IA_m;
           stats_.calibration = *fit;
         }
-        alignment_ = Alignment{fit->T_EO, segment, 0.0, true, t};
+        alignment_ = Alignment{fit->T_EO, segment, 0.0, true, t, options_.fine_heading_sigma_deg * core::kDegToRad};
         stats_.alignments.push_back(AlignmentEvent{t, first ? "initial" : (fine ? "realign" : "align"), fit->points,
                                                    fit->first_eigenvalue_ratio, fit->rmse_m,
                                                    fit->rmse_without_calibration_m, 0.0});
@@ -415,9 +453,12 @@ void FusionEngine::update_alignment(const core::GpsTime& t, const std::optional<
     }
     auto coarse = coarse_align(coarse_points, t_IA_m_, options_.alignment);
     const double max_sigma_rad = options_.coarse_max_yaw_sigma_deg * core::kDegToRad;
+    const auto current_sigma_rad = [this]() {
+      return options_.heading_state ? alignment_->heading_sigma_rad : alignment_->yaw_sigma_rad;
+    };
     if (coarse && coarse->spread_m >= options_.coarse_min_spread_m && coarse->yaw_sigma_rad <= max_sigma_rad &&
-        (!alignment_ || coarse->yaw_sigma_rad < alignment_->yaw_sigma_rad)) {
-      alignment_ = Alignment{coarse->T_EO, segment, coarse->yaw_sigma_rad, false, t};
+        (!alignment_ || coarse->yaw_sigma_rad < current_sigma_rad())) {
+      alignment_ = Alignment{coarse->T_EO, segment, coarse->yaw_sigma_rad, false, t, coarse->yaw_sigma_rad};
       stats_.alignments.push_back(AlignmentEvent{t, "coarse", static_cast<int>(coarse_points.size()), 0.0,
                                                  coarse->rmse_m, coarse->rmse_m,
                                                  coarse->yaw_sigma_rad * core::kRadToDeg});
@@ -442,6 +483,11 @@ std::vector<std::string> FusionEngine::report() const {
                          s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
                   format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of an undetermined position",
                          s.cn0_screened, s.undetermined_fix_epochs));
+  if (options_.heading_state) {
+    lines.push_back(format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "
+                           "heading sigma %.2f deg at the end",
+                           s.heading_folded_rad * core::kRadToDeg, s.heading_sigma_rad * core::kRadToDeg));
+  }
   int coarse = 0, fine = 0;
   for (const AlignmentEvent& a : s.alignments) (a.kind == "coarse" ? coarse : fine) += 1;
   lines.push_back(format("fusion: alignments: %.0f fine of %.0f windows tried (%.0f with FER >= the limit, ", fine,

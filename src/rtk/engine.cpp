@@ -479,6 +479,7 @@ void RtkEngine::time_update(const core::GpsTime& t, const gnss::SppSolution& spp
     Q_N(2, 2) = options_.accel_sigma_v_mps2 * options_.accel_sigma_v_mps2 * dt_s;
     P_.block<3, 3>(6, 6) += R_EN * Q_N * R_EN.transpose();
   }
+  heading_live_ = false;  // an epoch without aiding: the next aided one restarts the heading error
   // Ambiguities and ionosphere: random walks.
   const double q_amb = options_.ambiguity_noise_cyc * options_.ambiguity_noise_cyc * dt_s;
   const double q_iono = options_.iono_noise_m * options_.iono_noise_m * dt_s;
@@ -494,6 +495,7 @@ void RtkEngine::aided_time_update(const core::GpsTime& t, const RtkAiding& aidin
   const double dt_s = last_time_ ? std::abs(t - *last_time_) : 0.0;
   x_.head<3>() += aiding.delta_p_E_m;
   P_.topLeftCorner<3, 3>() += 0.5 * (aiding.Q_E_m2 + aiding.Q_E_m2.transpose());
+  if (options_.aiding_heading_state) propagate_heading(aiding);
   const int k = num_kinematic_states();
   const double q_amb = options_.ambiguity_noise_cyc * options_.ambiguity_noise_cyc * dt_s;
   const double q_iono = options_.iono_noise_m * options_.iono_noise_m * dt_s;
@@ -501,6 +503,35 @@ void RtkEngine::aided_time_update(const core::GpsTime& t, const RtkAiding& aidin
     P_(i, i) += ambiguity_keys_[static_cast<std::size_t>(i - k)].second == kIonoKey ? q_iono : q_amb;
   }
   last_time_ = t;
+}
+
+void RtkEngine::propagate_heading(const RtkAiding& aiding) {
+  const int h = heading_index();
+  if (aiding.restart_heading || !heading_live_) {
+    x_[h] = 0.0;
+    P_.row(h).setZero();
+    P_.col(h).setZero();
+    P_(h, h) = aiding.heading_variance_rad2;
+    heading_live_ = true;
+  }
+  // F = I + J e_h^T: F P gives the position rows J times row h, then (F P) F^T the position columns column h J^T.
+  const Eigen::Vector3d& J = aiding.dp_d_heading_E_m;
+  x_.head<3>() += J * x_[h];
+  P_.topRows<3>() += J * P_.row(h);
+  P_.leftCols<3>() += P_.col(h) * J.transpose();
+  P_(h, h) += aiding.heading_noise_rad2;
+}
+
+std::optional<RtkEngine::HeadingError> RtkEngine::heading_error() const {
+  if (!options_.aiding_heading_state || !heading_live_) return std::nullopt;
+  const int h = heading_index();
+  return HeadingError{x_[h], P_(h, h)};
+}
+
+std::optional<RtkEngine::HeadingError> RtkEngine::take_heading_error() {
+  std::optional<HeadingError> heading = heading_error();
+  if (heading) x_[heading_index()] = 0.0;
+  return heading;
 }
 
 void RtkEngine::revert_to_prior() {

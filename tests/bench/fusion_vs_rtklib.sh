@@ -8,7 +8,8 @@
 #     the wall and CPU times of each program on the same files (RTKLIB / fusion = how much faster fusion is).
 #  2. Ablations of the fusion on the same files: without VIO covariance propagation (constant 5 cm per axis per epoch),
 #     without pruning (no innovation gate, no ILS pruning), without lever-arm calibration, the constant-velocity model
-#     instead of VIO; and the gates alone (paper, chi-square), without the false-fix guard, without the C/N0 screen.
+#     instead of VIO; and the gates alone (paper, chi-square), without the false-fix guard, without the C/N0 screen,
+#     without the heading error state.
 #  3. instinct-spirent-rtk-sim (real receiver-simulator GNSS files, 1 Hz, truth with attitude) with VIO from its truth
 #     (`canyon simulate --vio-from-truth`), the 5 and then 10 most observed satellites excluded, GPS+Galileo for canyon
 #     (RTKLIB 2.4.3 reads no Galileo record of these navigation files: GPS only), and GPS only for all three.
@@ -61,6 +62,7 @@ variant gate-paper "gate=paper"
 variant gate-chi-square "gate=chi_square"
 variant no-guard "false_fix_guard=false"
 variant no-cn0-screen "cn0_screen=false"
+variant no-heading "heading_state=false"
 
 now() { date +%s.%N; }
 elapsed() { awk -v s="$1" -v e="$2" 'BEGIN {printf "%.2f", e - s}'; }
@@ -155,7 +157,8 @@ echo "builds each epoch's geometry on a second thread, ahead of the filter)."
 if [[ ${ABLATIONS:-1} != 0 ]]; then
   echo
   echo "== 2. Ablations of canyon fusion (fix rate, availability, wrong fixes, 3D RMSE; same files as above)"
-  names=(full no-covariance no-pruning no-calibration constant-velocity gate-paper gate-chi-square no-guard no-cn0-screen)
+  names=(full no-covariance no-pruning no-calibration constant-velocity gate-paper gate-chi-square no-guard no-cn0-screen
+    no-heading)
   printf '%-14s %4s' scenario seed
   for name in "${names[@]}"; do printf ' | %-30s' "$name"; done
   echo
@@ -200,7 +203,6 @@ if [[ ${INSTINCT:-1} != 0 ]]; then
         if [[ $mode == rtk ]]; then cp "$root/config/rtk.yaml" "$cfg"; else cp "$tmp/fusion-full.yaml" "$cfg"; fi
         # The simulation's own models (Klobuchar, Saastamoinen), a short baseline: no ionosphere state.
         sed -i "s|^  systems: .*|  systems: [$systems]|; s|^  ionosphere: [a-z]* |  ionosphere: off |" "$cfg"
-        printf 'spp:\n  systems: [%s]\n' "$systems" | sed -n 2p >/dev/null
         sed -i '/^spp:/,$d' "$cfg"
         printf 'spp:\n  elevation_mask_deg: 15\n  systems: [%s]\n' "$systems" >>"$cfg"
       done

@@ -1,13 +1,20 @@
 // The RTK engine's aiding hook (rtk::RtkAiding), on a short simulated open-sky scenario: the prior is the state plus
 // the increment with the covariance added, revert_to_prior() restores it, accept_fix vetoes fixes, the gates reject
-// rows, and an aided epoch is solved without a single-point solution.
+// rows, an aided epoch is solved without a single-point solution, and a heading error state of the aiding adds its
+// share to the prior coherently and is learnt from the updates.
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include "canyon/app/scenario_config.hpp"
+#include "canyon/core/constants.hpp"
+#include "canyon/core/geodesy.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/rtk/engine.hpp"
 #include "canyon/sim/simulator.hpp"
@@ -155,6 +162,88 @@ TEST_F(RtkAidingTest, AnAidedEpochIsSolvedWithoutASinglePointSolution) {
   EXPECT_TRUE(r->aided);
   EXPECT_GT(r->num_dd_measurements, 0);
   EXPECT_LT((r->solution.p_E_m - simulation_->truth[20].p_E_m).norm(), 0.5);
+}
+
+TEST_F(RtkAidingTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
+  RtkOptions o = options();
+  o.aiding_heading_state = true;
+  RtkEngine engine(o, *ephemerides_, simulation_->base_p_E_m);
+  run(engine, 10);
+  const Eigen::Vector3d p0 = engine.position_E_m();
+  const Eigen::Matrix3d P0 = engine.position_covariance_E_m2();
+  EXPECT_FALSE(engine.heading_error().has_value());  // no aided epoch yet
+  const double variance = 0.1 * 0.1;                 // rad^2
+  const double noise = 1e-6;                         // rad^2 per epoch
+  // Two aided epochs, time updates only: a constant heading error psi moves the position by (J_1 + J_2) psi, so its
+  // share of the covariance is (J_1 + J_2) var (J_1 + J_2)^T (plus the second epoch's share of the first's noise),
+  // not J_1 var J_1^T + J_2 var J_2^T as white noise per increment would give.
+  Eigen::Vector3d dp_sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d Q_sum = Eigen::Matrix3d::Zero();
+  std::vector<Eigen::Vector3d> J;
+  for (int k = 10; k < 12; ++k) {
+    const core::ObsEpoch& e = simulation_->rover.epochs[static_cast<std::size_t>(k)];
+    RtkAiding a = truth_aiding(k, 0.01);
+    a.dp_d_heading_E_m = Eigen::Vector3d(1.0, -2.0, 0.5) * (k - 8);  // any Jacobian, different per epoch
+    a.heading_variance_rad2 = variance;
+    a.heading_noise_rad2 = noise;
+    a.restart_heading = k == 10;
+    auto more = engine.predict(e, base_at(e.time), &a);
+    ASSERT_TRUE(more.ok() && *more);
+    const RtkEpoch r = engine.take_epoch();
+    dp_sum += a.delta_p_E_m;
+    Q_sum += a.Q_E_m2;
+    J.push_back(a.dp_d_heading_E_m);
+    EXPECT_LT((r.prior_p_E_m - (p0 + dp_sum)).norm(), 1e-9);  // psi starts at zero
+  }
+  const Eigen::Vector3d J_sum = J[0] + J[1];
+  const Eigen::Matrix3d expected = P0 + Q_sum + J_sum * variance * J_sum.transpose() + J[1] * noise * J[1].transpose();
+  EXPECT_LT((engine.position_covariance_E_m2() - expected).norm(), 1e-9 * expected.norm());
+  ASSERT_TRUE(engine.heading_error().has_value());
+  EXPECT_DOUBLE_EQ(engine.heading_error()->psi_rad, 0.0);
+  EXPECT_NEAR(engine.heading_error()->variance_rad2, variance + 2.0 * noise, 1e-15);
+  // An epoch without aiding ends the estimate; the next aided epoch restarts it though it does not ask to.
+  const core::ObsEpoch& e12 = simulation_->rover.epochs[12];
+  ASSERT_TRUE(engine.process(e12, base_at(e12.time)).ok());
+  EXPECT_FALSE(engine.heading_error().has_value());
+  const core::ObsEpoch& e13 = simulation_->rover.epochs[13];
+  RtkAiding a = truth_aiding(13, 0.01);
+  a.dp_d_heading_E_m = Eigen::Vector3d(0.3, 0.2, 0.0);
+  a.heading_variance_rad2 = 0.04;
+  a.heading_noise_rad2 = noise;
+  auto more = engine.predict(e13, base_at(e13.time), &a);
+  ASSERT_TRUE(more.ok() && *more);
+  (void)engine.take_epoch();
+  ASSERT_TRUE(engine.heading_error().has_value());
+  EXPECT_NEAR(engine.heading_error()->variance_rad2, 0.04 + noise, 1e-15);
+}
+
+TEST_F(RtkAidingTest, TheUpdateLearnsAHeadingErrorFromHowGnssCorrectsTheIncrements) {
+  // The increments are the truth's rotated by 3 degrees about the vertical: the filter's heading error state
+  // converges to -3 degrees (the rotation that undoes it) once the rover has moved.
+  RtkOptions o = options();
+  o.aiding_heading_state = true;
+  RtkEngine engine(o, *ephemerides_, simulation_->base_p_E_m);
+  run(engine, 5);
+  const double psi_true = 3.0 * core::kDegToRad;
+  const Eigen::Vector3d up_E =
+      core::rotation_enu_from_ecef(core::ecef_to_geodetic(simulation_->base_p_E_m)).row(2).transpose();
+  const Eigen::Matrix3d R_error = Eigen::AngleAxisd(psi_true, up_E).toRotationMatrix();
+  const int n = static_cast<int>(simulation_->rover.epochs.size());
+  for (int k = 5; k < n; ++k) {
+    const core::ObsEpoch& e = simulation_->rover.epochs[static_cast<std::size_t>(k)];
+    RtkAiding a = truth_aiding(k, 0.002);
+    a.delta_p_E_m = R_error * a.delta_p_E_m;
+    a.dp_d_heading_E_m = up_E.cross(a.delta_p_E_m);
+    a.heading_variance_rad2 = std::pow(10.0 * core::kDegToRad, 2);
+    a.restart_heading = k == 5;
+    ASSERT_TRUE(engine.process(e, base_at(e.time), &a).ok());
+  }
+  ASSERT_TRUE(engine.heading_error().has_value());
+  const double sigma = std::sqrt(engine.heading_error()->variance_rad2);
+  EXPECT_NEAR(engine.heading_error()->psi_rad, -psi_true, std::max(3.0 * sigma, 0.2 * psi_true));
+  EXPECT_LT(sigma, 0.5 * psi_true);
+  std::printf("heading error: %.3f deg (truth %.3f), sigma %.3f deg\n",
+              engine.heading_error()->psi_rad / core::kDegToRad, -psi_true / core::kDegToRad, sigma / core::kDegToRad);
 }
 
 }  // namespace

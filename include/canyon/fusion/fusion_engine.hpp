@@ -14,6 +14,14 @@
 //  3. Prediction (vio_prediction.hpp, Eqs. 3-6): the engine's position state moves by dp_E = R_EO dp_O of the
 //     antenna's VIO increment since the state's epoch, its covariance grows by R_EO cov(dp_O) R_EO^T, ambiguities
 //     carry over (rtk::RtkAiding). Without an alignment: the engine's own time update (single point or dynamics).
+//     Beyond the paper (heading_state): the alignment's heading error psi is one more filter state; the increment is
+//     rotated by it about the local vertical (dp_E += (up x dp_E) psi), so that the updates learn it from how GNSS
+//     corrects the VIO motion. After every aided epoch psi is folded into T_EO (rotated about the vertical through the
+//     position) and the state restarts at zero with its variance kept; it starts at the coarse fit's yaw sigma or at
+//     fine_heading_sigma_deg after a fine alignment, and walks by heading_random_walk_deg_per_sqrt_km with the
+//     distance. Without it a fine alignment's heading is exact and a coarse one's sigma is added to every increment
+//     as if independent from one increment to the next, which it is not: the fill-in then drifts sideways by the
+//     whole error times the distance walked.
 //  4. Outlier satellite pruning in the update: DD phase innovations beyond gate_motion_factor x |dp_E| (the paper: 5x
 //     the VIO incremental motion, at least min_gate_m; applied to phase only: DD code noise is of that size) and/or
 //     DD phase and code innovations beyond gate_sigmas sqrt(h P h^T + r) (chi-square gate).
@@ -79,6 +87,12 @@ struct FusionOptions {
   double coarse_window_s = 60.0;           ///< its window (s)
   double coarse_min_spread_m = 5.0;        ///< RMS horizontal spread it needs (m)
   double coarse_max_yaw_sigma_deg = 30.0;  ///< largest yaw uncertainty it accepts (deg)
+  /// Beyond the paper: the heading error of the alignment as a filter state (rtk::RtkOptions::aiding_heading_state),
+  /// learnt from how GNSS corrects the VIO increments and folded into T_EO after every epoch; false: the alignment's
+  /// heading is taken as exact (fine) or its uncertainty is added to every increment as white noise (coarse).
+  bool heading_state = true;
+  double heading_random_walk_deg_per_sqrt_km = 1.0;  ///< VIO heading drift: the state's random walk (deg/sqrt(km))
+  double fine_heading_sigma_deg = 1.0;               ///< heading sigma after a fine alignment (deg)
   Prediction prediction = Prediction::Vio;
   bool vio_covariance = true;                ///< Eqs. 4-6; false: constant_increment_sigma_m per axis (ablation)
   double constant_increment_sigma_m = 0.05;  ///< (m)
@@ -142,6 +156,8 @@ struct FusionStats {
   int ar_pruned_epochs = 0;         ///< fixes obtained after pruning satellites by their ILS residual
   int reanchored = 0;               ///< floats taken after max_prior_rejections (the prior had drifted)
   int widened = 0;                  ///< priors widened after gate_conflict_epochs
+  double heading_folded_rad = 0.0;  ///< heading_state: the sum of the heading corrections folded into T_EO
+  double heading_sigma_rad = 0.0;   ///< heading_state: the heading error's sigma after the last aided epoch
   int alignment_tries = 0;
   int alignment_rejected_fer = 0;
   int alignment_rejected_rmse = 0;
@@ -214,6 +230,8 @@ class FusionEngine {
     double yaw_sigma_rad = 0.0;  // coarse
     bool fine = false;
     core::GpsTime time;
+    double heading_sigma_rad = 0.0;  // heading_state: the heading error's sigma (the fit's, then the filter's)
+    bool heading_started = false;    // heading_state: the filter's heading error has been restarted for it
   };
   struct WindowPoint {
     core::GpsTime time;
@@ -240,6 +258,9 @@ class FusionEngine {
   [[nodiscard]] std::vector<AlignmentPoint> window(const core::GpsTime& t, double span_s, int segment,
                                                    bool fixed_only) const;
   [[nodiscard]] std::string validate_float(const rtk::RtkEpoch& epoch) const;
+  /// heading_state: the filter's heading error rotates T_EO about the local vertical at the position, the state
+  /// starts again from zero with the same variance (a change of variables), the alignment keeps that sigma.
+  void fold_heading_error();
 
   FusionOptions options_;
   rtk::RtkOptions rtk_options_;

@@ -45,9 +45,14 @@
 //
 // External aiding (RtkAiding, per epoch; the VIO fusion of fusion/fusion_engine.hpp): the position's time update
 // becomes p += delta_p_E_m, P_pp += Q_E_m2 with its correlations to the ambiguities kept (an EKF prediction with the
-// external motion as the model); the epoch is solved even when the single-point solution fails; DD innovations are
-// also gated by the aiding's thresholds; a fix is accepted only if the aiding's accept_fix agrees; and the prior is
-// kept so that revert_to_prior() can undo the epoch's measurement update and ambiguity resolution.
+// external motion as the model). With RtkOptions::aiding_heading_state, one more state psi (rad, after the kinematic
+// block) is the error of the aiding frame's heading: the increment is rotated by psi about the local vertical,
+// p += delta_p_E_m + J psi with J = dp_d_heading_E_m (= up x delta_p), so P' = F P F^T with F = I + J e_psi^T; psi
+// is a random walk, restarted (value 0, variance heading_variance_rad2, uncorrelated) when the aiding asks for it and
+// after any epoch that was not aided. The DD measurements do not see psi: it is learnt through its correlation with
+// the position that the increments build up. The epoch is solved even when the single-point solution fails; DD
+// innovations are also gated by the aiding's thresholds; a fix is accepted only if the aiding's accept_fix agrees; and
+// the prior is kept so that revert_to_prior() can undo the epoch's measurement update and ambiguity resolution.
 //
 // Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA; a fix is accepted when it passes
 // the ratio test, the bootstrapped success rate of the float covariance reaches min_success_rate (the ratio test
@@ -136,6 +141,8 @@ struct RtkOptions {
   double iono_sigma_min_m = 0.001;      ///< the prior sigma is at least this (m), whatever the baseline
   double iono_noise_m = 0.001;          ///< SD ionosphere random walk (m per sqrt(s))
   gnss::SppOptions spp;                 ///< single-point solution (prior and fallback)
+  /// A heading-error state of the external aiding (see above); set by the aiding's owner (the fusion), not in YAML.
+  bool aiding_heading_state = false;
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;
@@ -150,6 +157,11 @@ struct RtkAiding {
   std::optional<double> max_normalised_innovation;        ///< |v| / sqrt(h P h^T + r) beyond is rejected
   /// A candidate fix's position and covariance; false rejects it. Empty: no check.
   std::function<bool(const Eigen::Vector3d&, const Eigen::Matrix3d&)> accept_fix;
+  // With RtkOptions::aiding_heading_state only:
+  Eigen::Vector3d dp_d_heading_E_m = Eigen::Vector3d::Zero();  ///< d(delta_p) / d(heading error): up x delta_p (m/rad)
+  double heading_noise_rad2 = 0.0;     ///< random walk of the heading error over this increment (rad^2)
+  double heading_variance_rad2 = 0.0;  ///< variance of the heading error when its state (re)starts (rad^2)
+  bool restart_heading = false;        ///< the aiding frame changed (a new alignment): restart the heading state
 };
 
 /// One epoch's result.
@@ -221,6 +233,15 @@ class RtkEngine {
   /// The position state (float, ECEF) and its covariance at state_time().
   [[nodiscard]] Eigen::Vector3d position_E_m() const { return x_.head<3>(); }
   [[nodiscard]] Eigen::Matrix3d position_covariance_E_m2() const { return P_.topLeftCorner<3, 3>(); }
+  /// The aiding's heading error state (rad) and its variance (rad^2), when it holds an estimate.
+  struct HeadingError {
+    double psi_rad = 0.0;
+    double variance_rad2 = 0.0;
+  };
+  [[nodiscard]] std::optional<HeadingError> heading_error() const;
+  /// heading_error(), then the state's value set to zero (its variance and correlations kept): the caller folds the
+  /// estimate into the aiding's frame.
+  std::optional<HeadingError> take_heading_error();
 
  private:
   // Keyed states after the kinematic block: (satellite, frequency rank) for an ambiguity, (satellite, kIonoKey) for
@@ -232,8 +253,10 @@ class RtkEngine {
     core::GpsTime last_seen;
   };
   void time_update(const core::GpsTime& t, const gnss::SppSolution& spp);
-  /// Time update with external aiding: p += delta, P_pp += Q, ambiguity random walks.
+  /// Time update with external aiding: p += delta, P_pp += Q, ambiguity random walks (and the heading coupling).
   void aided_time_update(const core::GpsTime& t, const RtkAiding& aiding);
+  /// p += J psi, P = F P F^T (F = I + J e_psi^T), psi's random walk; restarts psi first if asked or not live.
+  void propagate_heading(const RtkAiding& aiding);
   /// The single differences of the epoch at the state's position (the rover's satellite states are added to the
   /// geometry's, shared with its single-point solution).
   [[nodiscard]] std::vector<SingleDiff> single_differences(EpochGeometry& geometry) const;
@@ -325,7 +348,13 @@ class RtkEngine {
   /// Removes every keyed state (ambiguities, ionosphere) at once: instantaneous mode, each epoch.
   void clear_ambiguities();
   [[nodiscard]] int ambiguity_index(const AmbiguityKey& key) const;
-  [[nodiscard]] int num_kinematic_states() const { return options_.dynamics ? 9 : 3; }
+  /// Position (3), velocity and acceleration (6, with dynamics), the aiding's heading error (1, with
+  /// aiding_heading_state): the states before the keyed ones.
+  [[nodiscard]] int num_kinematic_states() const {
+    return (options_.dynamics ? 9 : 3) + (options_.aiding_heading_state ? 1 : 0);
+  }
+  /// Index of the heading error state; -1 without aiding_heading_state.
+  [[nodiscard]] int heading_index() const { return options_.aiding_heading_state ? (options_.dynamics ? 9 : 3) : -1; }
 
   struct PendingEpoch;  // the epoch between the stages (engine.cpp)
 
@@ -339,6 +368,7 @@ class RtkEngine {
   std::map<AmbiguityKey, AmbiguityInfo> ambiguity_info_;
   std::optional<core::GpsTime> last_time_;
   bool initialised_ = false;
+  bool heading_live_ = false;              // the heading error state holds an estimate (aided since its restart)
   EpochGeometryBuilder geometry_builder_;  // predict() without a geometry built ahead (it owns the slip detectors)
   std::map<DdKey, double> last_fix_;       // integers of the last accepted fix; pairs leave with their ambiguities
   // Aiding of the epoch being processed (nullptr otherwise), and the prior kept for revert_to_prior().
