@@ -484,9 +484,10 @@ std::vector<std::string> FusionEngine::report() const {
                   format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of an undetermined position",
                          s.cn0_screened, s.undetermined_fix_epochs));
   if (options_.heading_state) {
-    lines.push_back(format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "
-                           "heading sigma %.2f deg at the end",
-                           s.heading_folded_rad * core::kRadToDeg, s.heading_sigma_rad * core::kRadToDeg));
+    lines.push_back(
+        format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "
+               "heading sigma %.2f deg at the end",
+               s.heading_folded_rad * core::kRadToDeg, s.heading_sigma_rad * core::kRadToDeg));
   }
   int coarse = 0, fine = 0;
   for (const AlignmentEvent& a : s.alignments) (a.kind == "coarse" ? coarse : fine) += 1;
