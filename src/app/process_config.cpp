@@ -177,6 +177,10 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("heading_state", o.heading_state);
   map.get("heading_random_walk_deg_per_sqrt_km", o.heading_random_walk_deg_per_sqrt_km);
   map.get("fine_heading_sigma_deg", o.fine_heading_sigma_deg);
+  map.get("integrity_check", o.integrity_check);
+  map.get("integrity_window_s", o.integrity_window_s);
+  map.get("integrity_min_points", o.integrity_min_points);
+  map.get("integrity_max_offset_m", o.integrity_max_offset_m);
   std::string prediction = fusion::prediction_name(o.prediction);
   map.get("prediction", prediction);
   if (prediction == "vio") {
@@ -442,6 +446,10 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("heading_state") << o.heading_state;
   key("heading_random_walk_deg_per_sqrt_km") << o.heading_random_walk_deg_per_sqrt_km;
   key("fine_heading_sigma_deg") << o.fine_heading_sigma_deg;
+  key("integrity_check") << o.integrity_check;
+  key("integrity_window_s") << o.integrity_window_s;
+  key("integrity_min_points") << o.integrity_min_points;
+  key("integrity_max_offset_m") << o.integrity_max_offset_m;
   key("prediction") << fusion::prediction_name(o.prediction);
   key("vio_covariance") << o.vio_covariance;
   key("constant_increment_sigma_m") << o.constant_increment_sigma_m;

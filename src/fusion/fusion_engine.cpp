@@ -18,6 +18,9 @@
 namespace canyon::fusion {
 namespace {
 
+/// The heading error's sigma after an integrity restart: wide, but within what its linearised state handles.
+constexpr double kRestartHeadingSigmaRad = 10.0 * core::kDegToRad;
+
 std::string when(const core::GpsTime& t) {
   const core::GpsTime n = t.normalized();
   char buffer[48];
@@ -73,6 +76,9 @@ std::string FusionOptions::validate() const {
   }
   if (!(coarse_window_s > 0.0) || !(coarse_min_spread_m > 0.0) || !(coarse_max_yaw_sigma_deg > 0.0)) {
     return "coarse_window_s, coarse_min_spread_m and coarse_max_yaw_sigma_deg must be > 0";
+  }
+  if (!(integrity_window_s > 0.0) || integrity_min_points < 1 || !(integrity_max_offset_m > 0.0)) {
+    return "integrity_window_s and integrity_max_offset_m must be > 0 and integrity_min_points >= 1";
   }
   if (!(heading_random_walk_deg_per_sqrt_km >= 0.0) || !(fine_heading_sigma_deg > 0.0)) {
     return "heading_random_walk_deg_per_sqrt_km must be >= 0 and fine_heading_sigma_deg > 0";
@@ -264,6 +270,8 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
     geometry->rtk.rover_obs = std::move(*geometry->screened_rover_obs);
     geometry->screened_rover_obs.reset();
   }
+  epoch_spp_p_E_m_.reset();
+  if (geometry->rtk.spp) epoch_spp_p_E_m_ = geometry->rtk.spp->p_E_m;
   auto more = engine_.predict(rover, base, aiding_ ? &*aiding_ : nullptr, &geometry->rtk);
   if (!more) {
     count_fix_rejections();
@@ -354,6 +362,11 @@ FusionEpoch FusionEngine::finish_epoch() {
   }
   if (out.solution.status == core::SolutionStatus::Fixed) ++stats_.fixed;
   if (out.aided) fold_heading_error();
+  if (out.aided && out.solution.status != core::SolutionStatus::None) {
+    check_integrity(out.solution.p_E_m);
+  } else {
+    spp_offsets_.clear();
+  }
   out.rejected = result->rejected;
   out.ar_pruned = result->ar_pruned;
   out.rtk = epoch;
@@ -387,6 +400,54 @@ void FusionEngine::fold_heading_error() {
   alignment_->heading_sigma_rad = std::sqrt(heading->variance_rad2);
   stats_.heading_folded_rad += heading->psi_rad;
   stats_.heading_sigma_rad = alignment_->heading_sigma_rad;
+}
+
+void FusionEngine::check_integrity(const Eigen::Vector3d& p_out_E_m) {
+  if (!options_.integrity_check || !epoch_spp_p_E_m_) return;
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_out_E_m));
+  spp_offsets_.push_back(SppOffset{epoch_time_, (R_NE * (*epoch_spp_p_E_m_ - p_out_E_m)).head<2>()});
+  const auto old = std::find_if(spp_offsets_.begin(), spp_offsets_.end(), [this](const SppOffset& o) {
+    return epoch_time_ - o.time <= options_.integrity_window_s;
+  });
+  spp_offsets_.erase(spp_offsets_.begin(), old);
+  if (static_cast<int>(spp_offsets_.size()) < options_.integrity_min_points) return;
+  Eigen::Vector2d median_m;
+  std::vector<double> values(spp_offsets_.size());
+  for (int axis = 0; axis < 2; ++axis) {
+    for (std::size_t i = 0; i < spp_offsets_.size(); ++i) values[i] = spp_offsets_[i].d_EN_m[axis];
+    const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), mid, values.end());
+    median_m[axis] = *mid;
+  }
+  if (median_m.norm() <= options_.integrity_max_offset_m) return;
+  stats_.notes.push_back(when(epoch_time_) +
+                         format(": integrity: the single points are %.0f m from the output (median over %.0f s): "
+                                "position moved to them, ambiguities and heading restarted",
+                                median_m.norm(), options_.integrity_window_s));
+  ++stats_.integrity_restarts;
+  restart_from_single_points(p_out_E_m, median_m);
+  spp_offsets_.clear();
+}
+
+void FusionEngine::restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Vector2d& median_EN_m) {
+  // Horizontally the single points' median, with their spread about it as its variance; vertically the output's.
+  Eigen::Vector2d spread2 = Eigen::Vector2d::Zero();
+  for (const SppOffset& o : spp_offsets_) spread2 += (o.d_EN_m - median_EN_m).cwiseAbs2();
+  spread2 /= static_cast<double>(spp_offsets_.size());
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_out_E_m));
+  Eigen::Matrix3d P_N = R_NE * engine_.position_covariance_E_m2() * R_NE.transpose();
+  P_N.topRows<2>().setZero();
+  P_N.leftCols<2>().setZero();
+  P_N(0, 0) = spread2[0];
+  P_N(1, 1) = spread2[1];
+  engine_.set_position(p_out_E_m + R_NE.transpose() * Eigen::Vector3d(median_EN_m[0], median_EN_m[1], 0.0),
+                       R_NE.transpose() * P_N * R_NE);
+  // The ambiguities were fitted to the old position; the heading may have been learnt from it.
+  engine_.reset_ambiguities();
+  if (alignment_) {
+    alignment_->heading_started = false;
+    alignment_->heading_sigma_rad = std::max(alignment_->heading_sigma_rad, kRestartHeadingSigmaRad);
+  }
 }
 
 std::vector<AlignmentPoint> FusionEngine::window(const core::GpsTime& t, double span_s, int segment,
@@ -488,6 +549,12 @@ std::vector<std::string> FusionEngine::report() const {
         format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "
                "heading sigma %.2f deg at the end",
                s.heading_folded_rad * core::kRadToDeg, s.heading_sigma_rad * core::kRadToDeg));
+  }
+  if (options_.integrity_check) {
+    lines.push_back(
+        format("fusion: integrity check: %.0f restarts from the single point (median offset over %.0f s "
+               "beyond %.0f m)",
+               s.integrity_restarts, options_.integrity_window_s, options_.integrity_max_offset_m));
   }
   int coarse = 0, fine = 0;
   for (const AlignmentEvent& a : s.alignments) (a.kind == "coarse" ? coarse : fine) += 1;

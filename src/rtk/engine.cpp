@@ -528,6 +528,13 @@ std::optional<RtkEngine::HeadingError> RtkEngine::heading_error() const {
   return HeadingError{x_[h], P_(h, h)};
 }
 
+void RtkEngine::set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2) {
+  x_.head<3>() = p_E_m;
+  P_.topRows<3>().setZero();
+  P_.leftCols<3>().setZero();
+  P_.topLeftCorner<3, 3>() = 0.5 * (P_E_m2 + P_E_m2.transpose());
+}
+
 std::optional<RtkEngine::HeadingError> RtkEngine::take_heading_error() {
   std::optional<HeadingError> heading = heading_error();
   if (heading) x_[heading_index()] = 0.0;

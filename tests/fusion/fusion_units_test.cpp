@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <random>
 #include <string>
@@ -540,31 +541,37 @@ TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
 
 // --- Heading error state -------------------------------------------------------------------------------------------
 
-/// 3D RMSE of a fusion run over the simulation (every epoch with a solution), with config/fusion.yaml's settings and
-/// heading_state as given; `folded_deg`: the heading corrections folded into T_EO over the run.
-double fusion_rmse(const sim::Simulation& sim, const core::GpsTime& start, bool heading_state, double& folded_deg) {
+/// A fusion run over the simulation with config/fusion.yaml's settings, changed by `change`.
+struct FusionRun {
+  double rmse_m = 0.0;  // 3D, every epoch with a solution
+  int solved = 0;
+  FusionStats stats;
+};
+FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
+                     const std::function<void(FusionOptions&)>& change) {
+  FusionRun run;
   auto config = app::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/fusion.yaml").string());
   if (!config) {
     ADD_FAILURE() << config.error().to_string();
-    return 0.0;
+    return run;
   }
-  config->fusion.heading_state = heading_state;
+  change(config->fusion);
   const gnss::EphemerisStore eph(sim.nav);
   FusionEngine engine(config->fusion, config->rtk, eph, sim.base_p_E_m,
                       VioTrack::from_samples(track_samples(sim.vio.poses, start), start));
   std::size_t base = 0;
   double sum2 = 0.0;
-  int n = 0;
   for (std::size_t k = 0; k < sim.rover.epochs.size(); ++k) {
     const core::ObsEpoch& e = sim.rover.epochs[k];
     while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - e.time <= 0.05) ++base;
     auto out = engine.process(e, &sim.base.epochs[base]);
     if (!out || out->solution.status == core::SolutionStatus::None) continue;
     sum2 += (out->solution.p_E_m - sim.truth[k].p_E_m).squaredNorm();
-    ++n;
+    ++run.solved;
   }
-  folded_deg = engine.stats().heading_folded_rad * core::kRadToDeg;
-  return n > 0 ? std::sqrt(sum2 / n) : 0.0;
+  run.rmse_m = run.solved > 0 ? std::sqrt(sum2 / run.solved) : 0.0;
+  run.stats = engine.stats();
+  return run;
 }
 
 TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCanyon) {
@@ -573,15 +580,34 @@ TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCa
   // drifts sideways by that angle of the distance walked; with it the updates teach the filter the error.
   auto simulated = simulate_urban_severe(300.0, "heading", {}, 2);
   ASSERT_TRUE(simulated);
-  double folded_with = 0.0, folded_without = 0.0;
-  const double with = fusion_rmse(simulated->sim, simulated->scenario.start, true, folded_with);
-  const double without = fusion_rmse(simulated->sim, simulated->scenario.start, false, folded_without);
+  const FusionRun with = run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions&) {});
+  const FusionRun without =
+      run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions& o) { o.heading_state = false; });
+  const double folded_deg = with.stats.heading_folded_rad * core::kRadToDeg;
   std::printf("urban-severe seed 2, 300 s: 3D RMSE %.2f m with the heading state (%.1f deg folded), %.2f m without\n",
-              with, folded_with, without);
-  ASSERT_GT(with, 0.0);
-  EXPECT_LT(with, 0.6 * without);
-  EXPECT_GT(std::abs(folded_with), 2.0);
-  EXPECT_EQ(folded_without, 0.0);
+              with.rmse_m, folded_deg, without.rmse_m);
+  ASSERT_GT(with.rmse_m, 0.0);
+  EXPECT_LT(with.rmse_m, 0.6 * without.rmse_m);
+  EXPECT_GT(std::abs(folded_deg), 2.0);
+  EXPECT_EQ(without.stats.heading_folded_rad, 0.0);
+  EXPECT_EQ(with.stats.integrity_restarts, 0) << "a run that follows the single points is never restarted";
+}
+
+TEST(FusionIntegrityTest, AnOutputThatLeftTheSinglePointsStartsAgainFromThem) {
+  // urban-severe, seed 4: the first alignment is made to solutions tens of metres off and the VIO carries the
+  // position along, 90 m from the single points after 90 s of the 600. The integrity check moves it to them (and
+  // restarts the ambiguities and the heading); without it the error stays.
+  auto simulated = simulate_urban_severe(600.0, "integrity", {}, 4);
+  ASSERT_TRUE(simulated);
+  const FusionRun with = run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions&) {});
+  const FusionRun without =
+      run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions& o) { o.integrity_check = false; });
+  std::printf("urban-severe seed 4, 600 s: 3D RMSE %.1f m with the integrity check (%d restarts), %.1f m without\n",
+              with.rmse_m, with.stats.integrity_restarts, without.rmse_m);
+  EXPECT_GE(with.stats.integrity_restarts, 1);
+  EXPECT_EQ(without.stats.integrity_restarts, 0);
+  EXPECT_LT(with.rmse_m, 0.8 * without.rmse_m);
+  EXPECT_EQ(with.solved, without.solved) << "a restart keeps the VIO aligned: no epoch goes without a solution";
 }
 
 }  // namespace

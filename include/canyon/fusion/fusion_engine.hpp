@@ -41,6 +41,13 @@
 //     (p_fix - p_prior)^T (P_prior + P_fix)^-1 (p_fix - p_prior) > false_fix_chi2, and a fix whose position sigma
 //     (largest axis of P_fix) exceeds max_fix_sigma_m (integers fixed, position not: three satellites).
 //  7. Output: fixed, else float (Algorithm 1).
+//  8. Beyond the paper, an integrity check (integrity_check): the horizontal offset of the epoch's single-point
+//     solution from the output, in local east and north, is kept over integrity_window_s of aided epochs; when the
+//     median offset (per axis) of at least integrity_min_points of them exceeds integrity_max_offset_m, the fusion has
+//     carried a wrong position along (an alignment to solutions far off, NLOS floats that pulled it away): the
+//     alignment and every ambiguity are dropped and the RTK engine starts again from the single point, until the VIO
+//     aligns again. Single points in street canyons are tens of metres off for tens of seconds at a time (a 30 s
+//     median up to 43 m on urban-severe), hence a median over a window and a bound above that.
 // Prediction "constant_velocity" (an ablation) replaces the VIO increment by v dt from the last two fixed or float
 // solutions (none if they are more than 5 s apart or imply more than vio_max_speed_mps), with covariance
 // (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
@@ -93,6 +100,10 @@ struct FusionOptions {
   bool heading_state = true;
   double heading_random_walk_deg_per_sqrt_km = 1.0;  ///< VIO heading drift: the state's random walk (deg/sqrt(km))
   double fine_heading_sigma_deg = 1.0;               ///< heading sigma after a fine alignment (deg)
+  bool integrity_check = true;           ///< beyond the paper: restart when the output leaves the single points (8.)
+  double integrity_window_s = 30.0;      ///< its window of aided epochs (s)
+  int integrity_min_points = 50;         ///< single points the window needs before it judges
+  double integrity_max_offset_m = 60.0;  ///< median horizontal offset of the single points beyond which it restarts
   Prediction prediction = Prediction::Vio;
   bool vio_covariance = true;                ///< Eqs. 4-6; false: constant_increment_sigma_m per axis (ablation)
   double constant_increment_sigma_m = 0.05;  ///< (m)
@@ -158,6 +169,7 @@ struct FusionStats {
   int widened = 0;                  ///< priors widened after gate_conflict_epochs
   double heading_folded_rad = 0.0;  ///< heading_state: the sum of the heading corrections folded into T_EO
   double heading_sigma_rad = 0.0;   ///< heading_state: the heading error's sigma after the last aided epoch
+  int integrity_restarts = 0;       ///< integrity_check: restarts from the single point
   int alignment_tries = 0;
   int alignment_rejected_fer = 0;
   int alignment_rejected_rmse = 0;
@@ -261,6 +273,16 @@ class FusionEngine {
   /// heading_state: the filter's heading error rotates T_EO about the local vertical at the position, the state
   /// starts again from zero with the same variance (a change of variables), the alignment keeps that sigma.
   void fold_heading_error();
+  /// integrity_check: adds the epoch's single-point offset from `p_out_E_m` to the window and restarts when its
+  /// median is beyond the bound.
+  void check_integrity(const Eigen::Vector3d& p_out_E_m);
+  /// Moves the position horizontally by the single points' median offset, with their spread as its variance, and
+  /// restarts the ambiguities and the heading error.
+  void restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Vector2d& median_EN_m);
+  struct SppOffset {
+    core::GpsTime time;
+    Eigen::Vector2d d_EN_m;  // single point minus output, local east and north (m)
+  };
 
   FusionOptions options_;
   rtk::RtkOptions rtk_options_;
@@ -288,6 +310,8 @@ class FusionEngine {
   core::GpsTime epoch_time_;
   std::optional<VioPoseAt> epoch_pose_;
   std::optional<rtk::RtkAiding> aiding_;  // alive from predict() to finish_epoch(): the RTK engine points to it
+  std::optional<Eigen::Vector3d> epoch_spp_p_E_m_;  // the epoch's single point, if any
+  std::vector<SppOffset> spp_offsets_;              // integrity_check's window
   std::optional<PendingAlignment> pending_alignment_;
 };
 

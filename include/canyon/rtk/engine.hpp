@@ -242,6 +242,11 @@ class RtkEngine {
   /// heading_error(), then the state's value set to zero (its variance and correlations kept): the caller folds the
   /// estimate into the aiding's frame.
   std::optional<HeadingError> take_heading_error();
+  /// Removes every ambiguity and ionosphere state (between epochs): the next epochs start them afresh, as after a
+  /// loss of lock on every satellite.
+  void reset_ambiguities() { clear_ambiguities(); }
+  /// Sets the position state (between epochs), uncorrelated with the other states: a re-anchoring from outside.
+  void set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2);
 
  private:
   // Keyed states after the kinematic block: (satellite, frequency rank) for an ambiguity, (satellite, kIonoKey) for
