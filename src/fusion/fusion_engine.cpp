@@ -13,6 +13,7 @@
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/statistics.hpp"
 #include "canyon/fusion/vio_prediction.hpp"
 
 namespace canyon::fusion {
@@ -140,7 +141,7 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
       const double walk_rad = options_.heading_random_walk_deg_per_sqrt_km * core::kDegToRad;
       aiding.dp_d_heading_E_m = up_E.cross(inc.dp_E_m);
       aiding.heading_noise_rad2 = walk_rad * walk_rad * inc.dp_E_m.norm() / 1000.0;
-      aiding.heading_variance_rad2 = alignment_->heading_sigma_rad * alignment_->heading_sigma_rad;
+      aiding.heading_variance_rad2 = alignment_->yaw_sigma_rad * alignment_->yaw_sigma_rad;
       aiding.restart_heading = !alignment_->heading_started;
       alignment_->heading_started = true;
     }
@@ -397,44 +398,40 @@ void FusionEngine::fold_heading_error() {
   const Eigen::Quaterniond q_psi(Eigen::AngleAxisd(heading->psi_rad, up_E));
   core::Pose& T_EO = alignment_->T_EO;
   T_EO = core::Pose{(q_psi * T_EO.q).normalized(), q_psi * (T_EO.p - p_E_m) + p_E_m};
-  alignment_->heading_sigma_rad = std::sqrt(heading->variance_rad2);
+  alignment_->yaw_sigma_rad = std::sqrt(heading->variance_rad2);
   stats_.heading_folded_rad += heading->psi_rad;
-  stats_.heading_sigma_rad = alignment_->heading_sigma_rad;
+  stats_.heading_sigma_rad = alignment_->yaw_sigma_rad;
 }
 
 void FusionEngine::check_integrity(const Eigen::Vector3d& p_out_E_m) {
   if (!options_.integrity_check || !epoch_spp_p_E_m_) return;
   const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_out_E_m));
   spp_offsets_.push_back(SppOffset{epoch_time_, (R_NE * (*epoch_spp_p_E_m_ - p_out_E_m)).head<2>()});
-  const auto old = std::find_if(spp_offsets_.begin(), spp_offsets_.end(), [this](const SppOffset& o) {
-    return epoch_time_ - o.time <= options_.integrity_window_s;
-  });
-  spp_offsets_.erase(spp_offsets_.begin(), old);
+  while (epoch_time_ - spp_offsets_.front().time > options_.integrity_window_s) spp_offsets_.pop_front();
   if (static_cast<int>(spp_offsets_.size()) < options_.integrity_min_points) return;
-  Eigen::Vector2d median_m;
-  std::vector<double> values(spp_offsets_.size());
-  for (int axis = 0; axis < 2; ++axis) {
-    for (std::size_t i = 0; i < spp_offsets_.size(); ++i) values[i] = spp_offsets_[i].d_EN_m[axis];
-    const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), mid, values.end());
-    median_m[axis] = *mid;
-  }
+  const Eigen::Vector2d median_m(median_offset_m(0), median_offset_m(1));
   if (median_m.norm() <= options_.integrity_max_offset_m) return;
   stats_.notes.push_back(when(epoch_time_) +
                          format(": integrity: the single points are %.0f m from the output (median over %.0f s): "
                                 "position moved to them, ambiguities and heading restarted",
                                 median_m.norm(), options_.integrity_window_s));
   ++stats_.integrity_restarts;
-  restart_from_single_points(p_out_E_m, median_m);
+  restart_from_single_points(p_out_E_m, R_NE, median_m);
   spp_offsets_.clear();
 }
 
-void FusionEngine::restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Vector2d& median_EN_m) {
+double FusionEngine::median_offset_m(int axis) {
+  median_scratch_m_.clear();
+  for (const SppOffset& o : spp_offsets_) median_scratch_m_.push_back(o.d_EN_m[axis]);
+  return core::median_in_place(median_scratch_m_);
+}
+
+void FusionEngine::restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Matrix3d& R_NE,
+                                              const Eigen::Vector2d& median_EN_m) {
   // Horizontally the single points' median, with their spread about it as its variance; vertically the output's.
   Eigen::Vector2d spread2 = Eigen::Vector2d::Zero();
   for (const SppOffset& o : spp_offsets_) spread2 += (o.d_EN_m - median_EN_m).cwiseAbs2();
   spread2 /= static_cast<double>(spp_offsets_.size());
-  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_out_E_m));
   Eigen::Matrix3d P_N = R_NE * engine_.position_covariance_E_m2() * R_NE.transpose();
   P_N.topRows<2>().setZero();
   P_N.leftCols<2>().setZero();
@@ -446,7 +443,7 @@ void FusionEngine::restart_from_single_points(const Eigen::Vector3d& p_out_E_m, 
   engine_.reset_ambiguities();
   if (alignment_) {
     alignment_->heading_started = false;
-    alignment_->heading_sigma_rad = std::max(alignment_->heading_sigma_rad, kRestartHeadingSigmaRad);
+    alignment_->yaw_sigma_rad = std::max(alignment_->yaw_sigma_rad, kRestartHeadingSigmaRad);
   }
 }
 
@@ -494,7 +491,8 @@ void FusionEngine::update_alignment(const core::GpsTime& t, const std::optional<
           t_IA_m_ = fit->t_IA_m;
           stats_.calibration = *fit;
         }
-        alignment_ = Alignment{fit->T_EO, segment, 0.0, true, t, options_.fine_heading_sigma_deg * core::kDegToRad};
+        const double fine_sigma_rad = options_.heading_state ? options_.fine_heading_sigma_deg * core::kDegToRad : 0.0;
+        alignment_ = Alignment{fit->T_EO, segment, fine_sigma_rad, true, t};
         stats_.alignments.push_back(AlignmentEvent{t, first ? "initial" : (fine ? "realign" : "align"), fit->points,
                                                    fit->first_eigenvalue_ratio, fit->rmse_m,
                                                    fit->rmse_without_calibration_m, 0.0});
@@ -514,12 +512,9 @@ void FusionEngine::update_alignment(const core::GpsTime& t, const std::optional<
     }
     auto coarse = coarse_align(coarse_points, t_IA_m_, options_.alignment);
     const double max_sigma_rad = options_.coarse_max_yaw_sigma_deg * core::kDegToRad;
-    const auto current_sigma_rad = [this]() {
-      return options_.heading_state ? alignment_->heading_sigma_rad : alignment_->yaw_sigma_rad;
-    };
     if (coarse && coarse->spread_m >= options_.coarse_min_spread_m && coarse->yaw_sigma_rad <= max_sigma_rad &&
-        (!alignment_ || coarse->yaw_sigma_rad < current_sigma_rad())) {
-      alignment_ = Alignment{coarse->T_EO, segment, coarse->yaw_sigma_rad, false, t, coarse->yaw_sigma_rad};
+        (!alignment_ || coarse->yaw_sigma_rad < alignment_->yaw_sigma_rad)) {
+      alignment_ = Alignment{coarse->T_EO, segment, coarse->yaw_sigma_rad, false, t};
       stats_.alignments.push_back(AlignmentEvent{t, "coarse", static_cast<int>(coarse_points.size()), 0.0,
                                                  coarse->rmse_m, coarse->rmse_m,
                                                  coarse->yaw_sigma_rad * core::kRadToDeg});

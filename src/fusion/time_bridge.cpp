@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "canyon/core/statistics.hpp"
+
 namespace canyon::fusion {
 namespace {
 
@@ -13,12 +15,9 @@ constexpr int kMaxIterations = 20;
 constexpr double kMadToSigma = 1.4826;
 constexpr std::int64_t kNsPerWeek = std::int64_t{core::kSecondsPerWeek} * 1000000000;
 
+/// The median of a copy: the callers keep their vectors' order.
 double median(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  if (v.size() % 2 == 1) return *mid;
-  const double upper = *mid;
-  return 0.5 * (upper + *std::max_element(v.begin(), mid));
+  return core::median_in_place(v);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/observation.hpp"
+#include "canyon/core/statistics.hpp"
 
 namespace canyon::rtk {
 
@@ -28,16 +29,6 @@ namespace {
 
 bool is_finite(double v) {
   return std::isfinite(v);
-}
-
-/// Median of a non-empty vector (reorders it).
-double median(std::vector<double>& values) {
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid));
-  return 0.5 * (lower + upper);
 }
 
 SlipEvent make_event(CycleSlipDetector::Key key, SlipCause cause, double value) {
@@ -192,7 +183,7 @@ void CycleSlipDetector::test_doppler(std::vector<Current>& signals, core::GpsTim
   std::vector<double> clock_jumps_s;
   clock_jumps_s.reserve(residuals.size());
   for (const Residual& r : residuals) clock_jumps_s.push_back(r.residual_m / r.scale_m_per_s);
-  const double clock_jump_s = median(clock_jumps_s);
+  const double clock_jump_s = core::median_in_place(clock_jumps_s);
   for (const Residual& r : residuals) {
     const double corrected_m = r.residual_m - clock_jump_s * r.scale_m_per_s;
     const double threshold_m = options_.doppler_threshold_m + options_.doppler_threshold_rate_mps * r.dt_s;

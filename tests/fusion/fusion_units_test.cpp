@@ -574,15 +574,27 @@ FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
   return run;
 }
 
+/// urban-severe (seed, duration) fused with config/fusion.yaml as it is and with one feature turned off.
+struct Comparison {
+  FusionRun with;
+  FusionRun without;
+};
+std::optional<Comparison> with_and_without(std::uint64_t seed, double duration_s, const std::string& tag,
+                                           const std::function<void(FusionOptions&)>& turn_off) {
+  auto simulated = simulate_urban_severe(duration_s, tag, {}, seed);
+  if (!simulated) return std::nullopt;
+  const core::GpsTime start = simulated->scenario.start;
+  return Comparison{run_fusion(simulated->sim, start, [](FusionOptions&) {}),
+                    run_fusion(simulated->sim, start, turn_off)};
+}
+
 TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCanyon) {
   // urban-severe, seed 2: the walk starts in the canyon, no window passes the paper's gates (a straight street), and
   // the coarse alignment fitted to metre-level float solutions is off by degrees. Without the heading state the fill-in
   // drifts sideways by that angle of the distance walked; with it the updates teach the filter the error.
-  auto simulated = simulate_urban_severe(300.0, "heading", {}, 2);
-  ASSERT_TRUE(simulated);
-  const FusionRun with = run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions&) {});
-  const FusionRun without =
-      run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions& o) { o.heading_state = false; });
+  const auto runs = with_and_without(2, 300.0, "heading", [](FusionOptions& o) { o.heading_state = false; });
+  ASSERT_TRUE(runs);
+  const auto& [with, without] = *runs;
   const double folded_deg = with.stats.heading_folded_rad * core::kRadToDeg;
   std::printf("urban-severe seed 2, 300 s: 3D RMSE %.2f m with the heading state (%.1f deg folded), %.2f m without\n",
               with.rmse_m, folded_deg, without.rmse_m);
@@ -597,11 +609,9 @@ TEST(FusionIntegrityTest, AnOutputThatLeftTheSinglePointsStartsAgainFromThem) {
   // urban-severe, seed 4: the first alignment is made to solutions tens of metres off and the VIO carries the
   // position along, 90 m from the single points after 90 s of the 600. The integrity check moves it to them (and
   // restarts the ambiguities and the heading); without it the error stays.
-  auto simulated = simulate_urban_severe(600.0, "integrity", {}, 4);
-  ASSERT_TRUE(simulated);
-  const FusionRun with = run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions&) {});
-  const FusionRun without =
-      run_fusion(simulated->sim, simulated->scenario.start, [](FusionOptions& o) { o.integrity_check = false; });
+  const auto runs = with_and_without(4, 600.0, "integrity", [](FusionOptions& o) { o.integrity_check = false; });
+  ASSERT_TRUE(runs);
+  const auto& [with, without] = *runs;
   std::printf("urban-severe seed 4, 600 s: 3D RMSE %.1f m with the integrity check (%d restarts), %.1f m without\n",
               with.rmse_m, with.stats.integrity_restarts, without.rmse_m);
   EXPECT_GE(with.stats.integrity_restarts, 1);

@@ -52,6 +52,7 @@
 // solutions (none if they are more than 5 s apart or imply more than vio_max_speed_mps), with covariance
 // (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
 
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
@@ -239,11 +240,12 @@ class FusionEngine {
   struct Alignment {
     core::Pose T_EO;
     int segment = 0;
-    double yaw_sigma_rad = 0.0;  // coarse
+    // The heading's sigma: a coarse fit's; after a fine one 0 (taken as exact) or, with heading_state,
+    // fine_heading_sigma_deg; with heading_state the filter's from the first aided epoch on.
+    double yaw_sigma_rad = 0.0;
     bool fine = false;
     core::GpsTime time;
-    double heading_sigma_rad = 0.0;  // heading_state: the heading error's sigma (the fit's, then the filter's)
-    bool heading_started = false;    // heading_state: the filter's heading error has been restarted for it
+    bool heading_started = false;  // heading_state: the filter's heading error has been restarted for it
   };
   struct WindowPoint {
     core::GpsTime time;
@@ -276,9 +278,12 @@ class FusionEngine {
   /// integrity_check: adds the epoch's single-point offset from `p_out_E_m` to the window and restarts when its
   /// median is beyond the bound.
   void check_integrity(const Eigen::Vector3d& p_out_E_m);
+  /// The median of spp_offsets_ along one axis (0 east, 1 north).
+  [[nodiscard]] double median_offset_m(int axis);
   /// Moves the position horizontally by the single points' median offset, with their spread as its variance, and
   /// restarts the ambiguities and the heading error.
-  void restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Vector2d& median_EN_m);
+  void restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Matrix3d& R_NE,
+                                  const Eigen::Vector2d& median_EN_m);
   struct SppOffset {
     core::GpsTime time;
     Eigen::Vector2d d_EN_m;  // single point minus output, local east and north (m)
@@ -311,7 +316,8 @@ class FusionEngine {
   std::optional<VioPoseAt> epoch_pose_;
   std::optional<rtk::RtkAiding> aiding_;  // alive from predict() to finish_epoch(): the RTK engine points to it
   std::optional<Eigen::Vector3d> epoch_spp_p_E_m_;  // the epoch's single point, if any
-  std::vector<SppOffset> spp_offsets_;              // integrity_check's window
+  std::deque<SppOffset> spp_offsets_;               // integrity_check's window
+  std::vector<double> median_scratch_m_;            // its medians' working copy (kept: no allocation per epoch)
   std::optional<PendingAlignment> pending_alignment_;
 };
 
