@@ -181,6 +181,7 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("integrity_window_s", o.integrity_window_s);
   map.get("integrity_min_points", o.integrity_min_points);
   map.get("integrity_max_offset_m", o.integrity_max_offset_m);
+  map.get("heading_free_fill_in", o.heading_free_fill_in);
   std::string prediction = fusion::prediction_name(o.prediction);
   map.get("prediction", prediction);
   if (prediction == "vio") {
@@ -450,6 +451,7 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("integrity_window_s") << o.integrity_window_s;
   key("integrity_min_points") << o.integrity_min_points;
   key("integrity_max_offset_m") << o.integrity_max_offset_m;
+  key("heading_free_fill_in") << o.heading_free_fill_in;
   key("prediction") << fusion::prediction_name(o.prediction);
   key("vio_covariance") << o.vio_covariance;
   key("constant_increment_sigma_m") << o.constant_increment_sigma_m;

@@ -274,6 +274,9 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
   epoch_spp_p_E_m_.reset();
   if (geometry->rtk.spp) epoch_spp_p_E_m_ = geometry->rtk.spp->p_E_m;
   auto more = engine_.predict(rover, base, aiding_ ? &*aiding_ : nullptr, &geometry->rtk);
+  heading_free_epoch_.reset();
+  if (!more) heading_free_epoch_ = heading_free_solution(rover.time, pose);
+  if (heading_free_epoch_) return false;  // finish_epoch() outputs it
   if (!more) {
     count_fix_rejections();
     pending_alignment_ = PendingAlignment{rover.time, pose};
@@ -301,7 +304,50 @@ void FusionEngine::count_fix_rejections() {
   }
 }
 
+std::optional<core::Solution> FusionEngine::heading_free_solution(const core::GpsTime& t,
+                                                                  const std::optional<VioPoseAt>& pose) {
+  if (!options_.heading_free_fill_in || options_.prediction != Prediction::Vio || !pose || !heading_free_ ||
+      heading_free_->segment != pose->segment) {
+    return std::nullopt;
+  }
+  HeadingFreeTrack& track = *heading_free_;
+  {
+    const std::shared_lock lock(track_mutex_);
+    const std::optional<VioPoseAt> before = track_.pose_at(track.time);
+    if (!before || before->segment != pose->segment) return std::nullopt;
+    // R_EO = I: only the increment in O and its covariance are used, the vertical of which no heading changes.
+    const VioIncrement inc = vio_increment(before->T_OI, pose->T_OI, track_.joint_covariance(*before, *pose), t_IA_m_,
+                                           Eigen::Matrix3d::Identity());
+    track.dp_O_m += inc.dp_O_m;
+    track.var_up_m2 += inc.cov_O_m2(2, 2);
+    track.time = t;
+  }
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(track.p_E_m));
+  const double var_horizontal_m2 = track.dp_O_m.head<2>().squaredNorm() / 2.0;  // a circle of radius h
+  core::Solution s;
+  s.time = t;
+  s.status = core::SolutionStatus::VioFillIn;
+  s.p_E_m = track.p_E_m + R_NE.row(2).transpose() * track.dp_O_m.z();
+  s.P_E_m2 = track.P_E_m2 + R_NE.transpose() *
+                                Eigen::Vector3d(var_horizontal_m2, var_horizontal_m2, track.var_up_m2).asDiagonal() *
+                                R_NE;
+  return s;
+}
+
+FusionEpoch FusionEngine::finish_heading_free() {
+  count_fix_rejections();
+  FusionEpoch out;
+  out.solution = *heading_free_epoch_;
+  heading_free_epoch_.reset();
+  out.note = "VIO fill-in before an alignment: the heading unknown";
+  ++stats_.heading_free;
+  spp_offsets_.clear();
+  pending_alignment_ = PendingAlignment{epoch_time_, epoch_pose_};
+  return out;
+}
+
 FusionEpoch FusionEngine::finish_epoch() {
+  if (heading_free_epoch_) return finish_heading_free();
   const rtk::RtkEpoch epoch = engine_.take_epoch();
   const rtk::RtkEpoch* result = &epoch;
   count_fix_rejections();
@@ -378,6 +424,10 @@ FusionEpoch FusionEngine::finish_epoch() {
       out.solution.status != core::SolutionStatus::None) {
     history_.push_back(WindowPoint{epoch_time_, pose->T_OI, out.solution.p_E_m, out.solution.status,
                                    sigma_3d(out.solution.P_E_m2), pose->segment, out.aided});
+  }
+  if (pose && out.solution.status != core::SolutionStatus::None) {
+    heading_free_ = HeadingFreeTrack{out.solution.p_E_m, out.solution.P_E_m2, Eigen::Vector3d::Zero(), 0.0,
+                                     epoch_time_,        pose->segment};
   }
   const double keep_s = std::max({options_.alignment_window_s, options_.coarse_window_s}) + 1.0;
   while (!history_.empty() && epoch_time_ - history_.front().time > keep_s) history_.erase(history_.begin());
@@ -530,6 +580,8 @@ std::vector<std::string> FusionEngine::report() const {
       format("fusion: %.0f epochs: %.0f VIO-aided, %.0f VIO fill-in (Q 7), %.0f RTK motion model "
              "(not aligned or no VIO)",
              s.epochs, s.aided, s.fill_in, s.fallback));
+  lines.push_back(
+      format("fusion: heading-free VIO fill-in (Q 7; not aligned, no GNSS solution): %.0f epochs", s.heading_free));
   lines.push_back(
       format("fusion: float validation failed: %.0f no DD phase, %.0f post-fit residuals, %.0f "
              "inconsistent with the VIO prior",

@@ -9,7 +9,7 @@
 #  2. Ablations of the fusion on the same files: without VIO covariance propagation (constant 5 cm per axis per epoch),
 #     without pruning (no innovation gate, no ILS pruning), without lever-arm calibration, the constant-velocity model
 #     instead of VIO; and the gates alone (paper, chi-square), without the false-fix guard, without the C/N0 screen,
-#     without the heading error state, without the integrity check.
+#     without the heading error state, without the integrity check, without the heading-free fill-in.
 #  3. instinct-spirent-rtk-sim (real receiver-simulator GNSS files, 1 Hz, truth with attitude) with VIO from its truth
 #     (`canyon simulate --vio-from-truth`), the 5 and then 10 most observed satellites excluded, GPS+Galileo for canyon
 #     (RTKLIB 2.4.3 reads no Galileo record of these navigation files: GPS only), and GPS only for all three.
@@ -64,6 +64,7 @@ variant no-guard "false_fix_guard=false"
 variant no-cn0-screen "cn0_screen=false"
 variant no-heading "heading_state=false"
 variant no-integrity "integrity_check=false"
+variant no-heading-free "heading_free_fill_in=false"
 
 now() { date +%s.%N; }
 elapsed() { awk -v s="$1" -v e="$2" 'BEGIN {printf "%.2f", e - s}'; }
@@ -159,7 +160,7 @@ if [[ ${ABLATIONS:-1} != 0 ]]; then
   echo
   echo "== 2. Ablations of canyon fusion (fix rate, availability, wrong fixes, 3D RMSE; same files as above)"
   names=(full no-covariance no-pruning no-calibration constant-velocity gate-paper gate-chi-square no-guard no-cn0-screen
-    no-heading no-integrity)
+    no-heading no-integrity no-heading-free)
   printf '%-14s %4s' scenario seed
   for name in "${names[@]}"; do printf ' | %-30s' "$name"; done
   echo

@@ -506,7 +506,8 @@ TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
   const gnss::EphemerisStore eph(sim->nav);
   rtk::RtkOptions rtk_options;
   rtk_options.ionosphere = rtk::IonosphereModel::Estimate;
-  const FusionOptions options;
+  FusionOptions options;
+  options.coarse_min_spread_m = 5.0;  // the first 20 s unaligned: the screen's verdicts on them are not applied
   const VioTrack track =
       VioTrack::from_samples(track_samples(sim->vio.poses, simulated->scenario.start), simulated->scenario.start);
   FusionEngine own(options, rtk_options, eph, sim->base_p_E_m, track);
@@ -618,6 +619,25 @@ TEST(FusionIntegrityTest, AnOutputThatLeftTheSinglePointsStartsAgainFromThem) {
   EXPECT_EQ(without.stats.integrity_restarts, 0);
   EXPECT_LT(with.rmse_m, 0.8 * without.rmse_m);
   EXPECT_EQ(with.solved, without.solved) << "a restart keeps the VIO aligned: no epoch goes without a solution";
+}
+
+TEST(FusionHeadingFreeTest, AStartInTheCanyonHasASolutionAtEveryEpoch) {
+  // urban-severe, seed 10: GNSS solves the first 1.4 s (too little motion to align the VIO), then sees one or two
+  // satellites per system for a minute. Without the heading-free fill-in those epochs have no solution; with it each
+  // has one (the last solution moved by the VIO's vertical motion, its sigma the distance travelled), and no other
+  // epoch changes.
+  const auto runs =
+      with_and_without(10, 600.0, "heading-free", [](FusionOptions& o) { o.heading_free_fill_in = false; });
+  ASSERT_TRUE(runs);
+  const auto& [with, without] = *runs;
+  std::printf(
+      "urban-severe seed 10, 600 s: %d of %d epochs solved with the heading-free fill-in (%d by it), %d "
+      "without\n",
+      with.solved, with.stats.epochs, with.stats.heading_free, without.solved);
+  EXPECT_EQ(with.solved, with.stats.epochs);
+  EXPECT_GT(with.stats.heading_free, 100);
+  EXPECT_EQ(without.stats.heading_free, 0);
+  EXPECT_EQ(with.solved - without.solved, with.stats.heading_free);
 }
 
 }  // namespace

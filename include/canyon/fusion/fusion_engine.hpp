@@ -48,6 +48,10 @@
 //     alignment and every ambiguity are dropped and the RTK engine starts again from the single point, until the VIO
 //     aligns again. Single points in street canyons are tens of metres off for tens of seconds at a time (a 30 s
 //     median up to 43 m on urban-severe), hence a median over a window and a bound above that.
+//  9. Beyond the paper, a heading-free fill-in (heading_free_fill_in): before the VIO segment is aligned (a start in a
+//     canyon, or after a VIO reset), an epoch without any GNSS solution gets the last solution of the segment moved
+//     by the VIO's vertical motion (O is gravity-aligned), its horizontal motion of unknown direction standing as
+//     the uncertainty: sigma h / sqrt(2) per horizontal axis, h the horizontal distance travelled since (Q = 7).
 // Prediction "constant_velocity" (an ablation) replaces the VIO increment by v dt from the last two fixed or float
 // solutions (none if they are more than 5 s apart or imply more than vio_max_speed_mps), with covariance
 // (sigma_a^2 dt^3 / 3) I + (P_k + P_k-1) (dt / dt_k)^2, sigma_a the rtk option accel_sigma_h_mps2.
@@ -93,7 +97,7 @@ struct FusionOptions {
   Eigen::Vector3d lever_arm_prior_m = Eigen::Vector3d::Zero();  ///< t_IA prior (IMU frame, m)
   bool coarse_alignment = true;            ///< beyond the paper: gravity-aligned yaw fit while no window qualifies
   double coarse_window_s = 60.0;           ///< its window (s)
-  double coarse_min_spread_m = 5.0;        ///< RMS horizontal spread it needs (m)
+  double coarse_min_spread_m = 1.0;        ///< RMS horizontal spread it needs (m; its yaw sigma bound decides)
   double coarse_max_yaw_sigma_deg = 30.0;  ///< largest yaw uncertainty it accepts (deg)
   /// Beyond the paper: the heading error of the alignment as a filter state (rtk::RtkOptions::aiding_heading_state),
   /// learnt from how GNSS corrects the VIO increments and folded into T_EO after every epoch; false: the alignment's
@@ -105,6 +109,7 @@ struct FusionOptions {
   double integrity_window_s = 30.0;      ///< its window of aided epochs (s)
   int integrity_min_points = 50;         ///< single points the window needs before it judges
   double integrity_max_offset_m = 60.0;  ///< median horizontal offset of the single points beyond which it restarts
+  bool heading_free_fill_in = true;      ///< beyond the paper: before an alignment, the heading-free fill-in (9.)
   Prediction prediction = Prediction::Vio;
   bool vio_covariance = true;                ///< Eqs. 4-6; false: constant_increment_sigma_m per axis (ablation)
   double constant_increment_sigma_m = 0.05;  ///< (m)
@@ -171,6 +176,7 @@ struct FusionStats {
   double heading_folded_rad = 0.0;  ///< heading_state: the sum of the heading corrections folded into T_EO
   double heading_sigma_rad = 0.0;   ///< heading_state: the heading error's sigma after the last aided epoch
   int integrity_restarts = 0;       ///< integrity_check: restarts from the single point
+  int heading_free = 0;             ///< heading_free_fill_in: epochs it filled
   int alignment_tries = 0;
   int alignment_rejected_fer = 0;
   int alignment_rejected_rmse = 0;
@@ -284,6 +290,20 @@ class FusionEngine {
   /// restarts the ambiguities and the heading error.
   void restart_from_single_points(const Eigen::Vector3d& p_out_E_m, const Eigen::Matrix3d& R_NE,
                                   const Eigen::Vector2d& median_EN_m);
+  /// heading_free_fill_in: the last solution of the VIO segment and the antenna's VIO motion since.
+  struct HeadingFreeTrack {
+    Eigen::Vector3d p_E_m;
+    Eigen::Matrix3d P_E_m2;
+    Eigen::Vector3d dp_O_m = Eigen::Vector3d::Zero();  // antenna displacement since, in O (z up) (m)
+    double var_up_m2 = 0.0;                            // variance of its vertical component (m^2)
+    core::GpsTime time;                                // of the last pose added
+    int segment = 0;
+  };
+  /// The heading-free fill-in at t (9.), nullopt if there is none (option off, no anchor of the pose's segment).
+  [[nodiscard]] std::optional<core::Solution> heading_free_solution(const core::GpsTime& t,
+                                                                    const std::optional<VioPoseAt>& pose);
+  /// finish_epoch() of an epoch that predict() gave the heading-free fill-in.
+  FusionEpoch finish_heading_free();
   struct SppOffset {
     core::GpsTime time;
     Eigen::Vector2d d_EN_m;  // single point minus output, local east and north (m)
@@ -319,6 +339,8 @@ class FusionEngine {
   std::deque<SppOffset> spp_offsets_;               // integrity_check's window
   std::vector<double> median_scratch_m_;            // its medians' working copy (kept: no allocation per epoch)
   std::optional<PendingAlignment> pending_alignment_;
+  std::optional<HeadingFreeTrack> heading_free_;
+  std::optional<core::Solution> heading_free_epoch_;  // the epoch's heading-free fill-in, from predict()
 };
 
 }  // namespace canyon::fusion
