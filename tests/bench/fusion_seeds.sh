@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# Issue 5's urban-severe targets over many seeds: for each seed, canyon simulate, RTKLIB 2.4.3 (rnx2rtkp -k
+# config/rtklib/sim.conf) and canyon fusion (config/fusion.yaml or CONFIG), both scored by canyon evaluate; one line per
+# seed (3D RMSE, availability, RTKLIB's, whether fusion's RMSE <= 1/5 of RTKLIB's) and a tally: seeds with a solution
+# at every epoch, seeds meeting the RMSE ratio, median RMSE.
+# Usage: tests/bench/fusion_seeds.sh [BUILD_DIR] [FIRST] [LAST] [SCENARIO] [CONFIG]
+#   defaults: build, 1, 30, urban-severe, config/fusion.yaml. KEEP=1 keeps the temp folder and prints its path.
+# Exit status: 0 done, 2 missing build or tools.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=$(cd "${1:-$root/build}" && pwd)
+first=${2:-1}
+last=${3:-30}
+scenario=${4:-urban-severe}
+config=$(realpath "${5:-$root/config/fusion.yaml}")
+canyon=$build/canyon
+
+[[ -x $canyon ]] || { echo "error: $canyon not built (run scripts/build.sh)" >&2; exit 2; }
+command -v rnx2rtkp >/dev/null || { echo "error: rnx2rtkp not installed (run scripts/setup.sh)" >&2; exit 2; }
+command -v python3 >/dev/null || { echo "error: python3 needed to read the evaluations" >&2; exit 2; }
+
+tmp=$(mktemp -d)
+if [[ ${KEEP:-0} == 1 ]]; then
+  echo "keeping $tmp"
+else
+  trap 'rm -rf "$tmp"' EXIT
+fi
+
+for ((seed = first; seed <= last; ++seed)); do
+  dir=$tmp/$scenario-$seed
+  "$canyon" simulate -q --scenario "$scenario" --seed "$seed" --out "$dir"
+  rnx2rtkp -k "$root/config/rtklib/sim.conf" -o "$dir/rtklib.pos" "$dir/rover.obs" "$dir/base.obs" "$dir/nav.rnx" \
+    >/dev/null 2>&1 || true
+  "$canyon" process -q --config "$config" --rover "$dir/rover.obs" --base "$dir/base.obs" --nav "$dir/nav.rnx" \
+    --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" --out "$dir/fusion.pos" 2>"$dir/fusion.log" || true
+  "$canyon" evaluate -q --truth "$dir/truth.csv" --rover "$dir/rover.obs" --solution "$dir/rtklib.pos" \
+    --label RTKLIB --solution "$dir/fusion.pos" --label fusion --json "$dir/evaluation.json" || true
+  python3 - "$dir/evaluation.json" "$seed" <<'PY'
+import json, sys
+try:
+    solutions = {s["label"]: s for s in json.load(open(sys.argv[1]))["solutions"]}
+except (OSError, ValueError, KeyError):
+    print("seed %s: no evaluation" % sys.argv[2])
+    sys.exit(0)
+def figures(label):
+    s = solutions.get(label)
+    if not s or not s["ape"]["all"]["3d"]:
+        return float("nan"), 0.0
+    return s["ape"]["all"]["3d"]["rmse_m"], s["availability"]
+f, fa = figures("fusion")
+r, ra = figures("RTKLIB")
+print("seed %3s: fusion %8.2f m, %6.2f %% | RTKLIB %8.2f m, %6.2f %% | every epoch: %-3s | RMSE <= 1/5 RTKLIB: %s"
+      % (sys.argv[2], f, 100 * fa, r, 100 * ra, "yes" if fa >= 1.0 - 1e-9 else "no", "yes" if f <= r / 5 else "no"))
+PY
+done | tee "$tmp/seeds.txt"
+python3 - "$tmp/seeds.txt" <<'PY'
+import re, statistics, sys
+rows = [l for l in open(sys.argv[1]) if l.startswith("seed") and "fusion" in l]
+rmse = [float(re.search(r"fusion +([0-9.naN]+) m", l).group(1)) for l in rows]
+full = sum(1 for l in rows if "every epoch: yes" in l)
+ratio = sum(1 for l in rows if l.rstrip().endswith("yes"))
+valid = [x for x in rmse if x == x]
+print("%d seeds: a solution at every epoch on %d, RMSE <= 1/5 of RTKLIB's on %d, median fusion RMSE %.1f m"
+      % (len(rows), full, ratio, statistics.median(valid) if valid else float("nan")))
+PY
