@@ -275,7 +275,7 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
   if (geometry->rtk.spp) epoch_spp_p_E_m_ = geometry->rtk.spp->p_E_m;
   auto more = engine_.predict(rover, base, aiding_ ? &*aiding_ : nullptr, &geometry->rtk);
   heading_free_epoch_.reset();
-  if (!more) heading_free_epoch_ = heading_free_solution(rover.time, pose);
+  if (!more && !aiding_) heading_free_epoch_ = heading_free_solution(rover.time, pose);
   if (heading_free_epoch_) return false;  // finish_epoch() outputs it
   if (!more) {
     count_fix_rejections();

@@ -208,7 +208,7 @@ class FusionEngine {
   /// epoch, the RTK engine's prediction (rtk::RtkEngine::predict). `geometry`: the epoch's geometry built ahead by a
   /// builder from make_geometry_builder() that saw every epoch before this one (nullptr: the engine builds it; do not
   /// mix the two in one run); the prediction may move its observables. Error as process(); true if the epoch goes on
-  /// to update().
+  /// to update(), false if it goes straight to finish_epoch() (no base epoch, or the heading-free fill-in).
   Result<bool> predict(const core::ObsEpoch& rover, const core::ObsEpoch* base, const std::optional<VioPoseAt>& pose,
                        FusionGeometry* geometry = nullptr);
   /// A builder of the engine's epoch geometry (fusion_geometry.hpp), to run ahead of predict().
