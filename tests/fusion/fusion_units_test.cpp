@@ -507,7 +507,7 @@ TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
   rtk::RtkOptions rtk_options;
   rtk_options.ionosphere = rtk::IonosphereModel::Estimate;
   FusionOptions options;
-  options.coarse_min_spread_m = 5.0;  // the first 20 s unaligned: the screen's verdicts on them are not applied
+  options.coarse_min_spread_m = 5.0;  // the former bound: the test needs unaligned epochs (their verdicts unapplied)
   const VioTrack track =
       VioTrack::from_samples(track_samples(sim->vio.poses, simulated->scenario.start), simulated->scenario.start);
   FusionEngine own(options, rtk_options, eph, sim->base_p_E_m, track);
