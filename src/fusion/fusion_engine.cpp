@@ -126,16 +126,14 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
   rtk::RtkAiding aiding;
   const Eigen::Vector3d p_state = engine_.position_E_m();
   if (options_.prediction == Prediction::Vio) {
-    if (!alignment_ || !pose) return std::nullopt;
-    const std::shared_lock lock(track_mutex_);
-    const auto before = track_.pose_at(t_state);
-    if (!before || before->segment != pose->segment || pose->segment != alignment_->segment) return std::nullopt;
+    if (!alignment_ || !pose || pose->segment != alignment_->segment) return std::nullopt;
     const Eigen::Vector3d up_E =
         core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_state)).row(2).transpose();  // local vertical
     const bool heading_state = options_.heading_state;
-    const VioIncrement inc =
-        vio_increment(before->T_OI, pose->T_OI, track_.joint_covariance(*before, *pose), t_IA_m_,
-                      alignment_->T_EO.rotation(), heading_state ? 0.0 : alignment_->yaw_sigma_rad, up_E);
+    const std::optional<VioIncrement> increment = increment_since(
+        t_state, *pose, alignment_->T_EO.rotation(), heading_state ? 0.0 : alignment_->yaw_sigma_rad, up_E);
+    if (!increment) return std::nullopt;
+    const VioIncrement& inc = *increment;
     aiding.delta_p_E_m = inc.dp_E_m;
     if (heading_state) {
       const double walk_rad = options_.heading_random_walk_deg_per_sqrt_km * core::kDegToRad;
@@ -261,6 +259,7 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
                                    const std::optional<VioPoseAt>& pose, FusionGeometry* geometry) {
   epoch_time_ = rover.time;
   epoch_pose_ = pose;
+  heading_free_epoch_.reset();
   guard_rejections_epoch_ = 0;
   undetermined_fixes_epoch_ = 0;
   aiding_ = make_aiding(rover.time, pose);
@@ -274,10 +273,9 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
   epoch_spp_p_E_m_.reset();
   if (geometry->rtk.spp) epoch_spp_p_E_m_ = geometry->rtk.spp->p_E_m;
   auto more = engine_.predict(rover, base, aiding_ ? &*aiding_ : nullptr, &geometry->rtk);
-  heading_free_epoch_.reset();
-  if (!more && !aiding_) heading_free_epoch_ = heading_free_solution(rover.time, pose);
-  if (heading_free_epoch_) return false;  // finish_epoch() outputs it
   if (!more) {
+    if (!aiding_) heading_free_epoch_ = heading_free_solution(rover.time, pose);
+    if (heading_free_epoch_) return false;  // finish_epoch() outputs it
     count_fix_rejections();
     pending_alignment_ = PendingAlignment{rover.time, pose};
   }
@@ -304,6 +302,16 @@ void FusionEngine::count_fix_rejections() {
   }
 }
 
+std::optional<VioIncrement> FusionEngine::increment_since(const core::GpsTime& t_from, const VioPoseAt& pose,
+                                                          const Eigen::Matrix3d& R_EO, double yaw_sigma_rad,
+                                                          const Eigen::Vector3d& up_E) const {
+  const std::shared_lock lock(track_mutex_);
+  const std::optional<VioPoseAt> before = track_.pose_at(t_from);
+  if (!before || before->segment != pose.segment) return std::nullopt;
+  return vio_increment(before->T_OI, pose.T_OI, track_.joint_covariance(*before, pose), t_IA_m_, R_EO, yaw_sigma_rad,
+                       up_E);
+}
+
 std::optional<core::Solution> FusionEngine::heading_free_solution(const core::GpsTime& t,
                                                                   const std::optional<VioPoseAt>& pose) {
   if (!options_.heading_free_fill_in || options_.prediction != Prediction::Vio || !pose || !heading_free_ ||
@@ -311,17 +319,12 @@ std::optional<core::Solution> FusionEngine::heading_free_solution(const core::Gp
     return std::nullopt;
   }
   HeadingFreeTrack& track = *heading_free_;
-  {
-    const std::shared_lock lock(track_mutex_);
-    const std::optional<VioPoseAt> before = track_.pose_at(track.time);
-    if (!before || before->segment != pose->segment) return std::nullopt;
-    // R_EO = I: only the increment in O and its covariance are used, the vertical of which no heading changes.
-    const VioIncrement inc = vio_increment(before->T_OI, pose->T_OI, track_.joint_covariance(*before, *pose), t_IA_m_,
-                                           Eigen::Matrix3d::Identity());
-    track.dp_O_m += inc.dp_O_m;
-    track.var_up_m2 += inc.cov_O_m2(2, 2);
-    track.time = t;
-  }
+  // R_EO = I: only the increment in O and its covariance are used, the vertical of which no heading changes.
+  const std::optional<VioIncrement> inc = increment_since(track.time, *pose, Eigen::Matrix3d::Identity());
+  if (!inc) return std::nullopt;
+  track.dp_O_m += inc->dp_O_m;
+  track.var_up_m2 += inc->cov_O_m2(2, 2);
+  track.time = t;
   const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(track.p_E_m));
   const double var_horizontal_m2 = track.dp_O_m.head<2>().squaredNorm() / 2.0;  // a circle of radius h
   core::Solution s;

@@ -21,6 +21,7 @@ command -v rnx2rtkp >/dev/null || { echo "error: rnx2rtkp not installed (run scr
 command -v python3 >/dev/null || { echo "error: python3 needed to read the evaluations" >&2; exit 2; }
 
 tmp=$(mktemp -d)
+: >"$tmp/seeds.tsv"
 if [[ ${KEEP:-0} == 1 ]]; then
   echo "keeping $tmp"
 else
@@ -36,12 +37,13 @@ for ((seed = first; seed <= last; ++seed)); do
     --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" --out "$dir/fusion.pos" 2>"$dir/fusion.log" || true
   "$canyon" evaluate -q --truth "$dir/truth.csv" --rover "$dir/rover.obs" --solution "$dir/rtklib.pos" \
     --label RTKLIB --solution "$dir/fusion.pos" --label fusion --json "$dir/evaluation.json" || true
-  python3 - "$dir/evaluation.json" "$seed" <<'PY'
+  python3 - "$dir/evaluation.json" "$seed" "$tmp/seeds.tsv" <<'PY'
 import json, sys
+path, seed, table = sys.argv[1:4]
 try:
-    solutions = {s["label"]: s for s in json.load(open(sys.argv[1]))["solutions"]}
+    solutions = {s["label"]: s for s in json.load(open(path))["solutions"]}
 except (OSError, ValueError, KeyError):
-    print("seed %s: no evaluation" % sys.argv[2])
+    print("seed %s: no evaluation" % seed)
     sys.exit(0)
 def figures(label):
     s = solutions.get(label)
@@ -50,17 +52,18 @@ def figures(label):
     return s["ape"]["all"]["3d"]["rmse_m"], s["availability"]
 f, fa = figures("fusion")
 r, ra = figures("RTKLIB")
+every, ratio = fa >= 1.0 - 1e-9, f <= r / 5
 print("seed %3s: fusion %8.2f m, %6.2f %% | RTKLIB %8.2f m, %6.2f %% | every epoch: %-3s | RMSE <= 1/5 RTKLIB: %s"
-      % (sys.argv[2], f, 100 * fa, r, 100 * ra, "yes" if fa >= 1.0 - 1e-9 else "no", "yes" if f <= r / 5 else "no"))
+      % (seed, f, 100 * fa, r, 100 * ra, "yes" if every else "no", "yes" if ratio else "no"))
+with open(table, "a") as out:
+    out.write("%s\t%r\t%d\t%d\n" % (seed, f, every, ratio))
 PY
-done | tee "$tmp/seeds.txt"
-python3 - "$tmp/seeds.txt" <<'PY'
-import re, statistics, sys
-rows = [l for l in open(sys.argv[1]) if l.startswith("seed") and "fusion" in l]
-rmse = [float(re.search(r"fusion +([0-9.naN]+) m", l).group(1)) for l in rows]
-full = sum(1 for l in rows if "every epoch: yes" in l)
-ratio = sum(1 for l in rows if l.rstrip().endswith("yes"))
-valid = [x for x in rmse if x == x]
+done
+python3 - "$tmp/seeds.tsv" <<'PY'
+import math, statistics, sys
+rows = [line.split("\t") for line in open(sys.argv[1])]
+rmse = [float(r[1]) for r in rows if not math.isnan(float(r[1]))]
 print("%d seeds: a solution at every epoch on %d, RMSE <= 1/5 of RTKLIB's on %d, median fusion RMSE %.1f m"
-      % (len(rows), full, ratio, statistics.median(valid) if valid else float("nan")))
+      % (len(rows), sum(int(r[2]) for r in rows), sum(int(r[3]) for r in rows),
+         statistics.median(rmse) if rmse else float("nan")))
 PY

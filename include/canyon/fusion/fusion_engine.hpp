@@ -45,8 +45,9 @@
 //     solution from the output, in local east and north, is kept over integrity_window_s of aided epochs; when the
 //     median offset (per axis) of at least integrity_min_points of them exceeds integrity_max_offset_m, the fusion has
 //     carried a wrong position along (an alignment to solutions far off, NLOS floats that pulled it away): the
-//     alignment and every ambiguity are dropped and the RTK engine starts again from the single point, until the VIO
-//     aligns again. Single points in street canyons are tens of metres off for tens of seconds at a time (a 30 s
+//     position moves horizontally by that median (the single points' spread about it as its variance; the vertical
+//     and the alignment stay), every ambiguity starts again and so does the heading error (at least 10 deg). Single
+//     points in street canyons are tens of metres off for tens of seconds at a time (a 30 s
 //     median up to 43 m on urban-severe), hence a median over a window and a bound above that.
 //  9. Beyond the paper, a heading-free fill-in (heading_free_fill_in): before the VIO segment is aligned (a start in a
 //     canyon, or after a VIO reset), an epoch without any GNSS solution gets the last solution of the segment moved
@@ -72,6 +73,7 @@
 #include "canyon/fusion/cn0_screen.hpp"
 #include "canyon/fusion/fusion_geometry.hpp"
 #include "canyon/fusion/time_bridge.hpp"
+#include "canyon/fusion/vio_prediction.hpp"
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/rtk/engine.hpp"
@@ -274,6 +276,11 @@ class FusionEngine {
   void count_fix_rejections();
 
   std::optional<rtk::RtkAiding> make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
+  /// The antenna's VIO increment from the track's pose at GPST t_from to `pose` (vio_increment(), Eqs. 4-5), nullopt
+  /// if the track has no pose at t_from in pose's segment.
+  [[nodiscard]] std::optional<VioIncrement> increment_since(
+      const core::GpsTime& t_from, const VioPoseAt& pose, const Eigen::Matrix3d& R_EO, double yaw_sigma_rad = 0.0,
+      const Eigen::Vector3d& up_E = Eigen::Vector3d::UnitZ()) const;
   void update_alignment(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
   [[nodiscard]] std::vector<AlignmentPoint> window(const core::GpsTime& t, double span_s, int segment,
                                                    bool fixed_only) const;
