@@ -104,6 +104,9 @@ TEST(LiveRtcm, CanyonBaseServesNtripToStr2str) {
   const fs::path config = write_base_config(dir, false);
   const fs::path pulled = dir / "pulled.rtcm3";
   fs::remove(pulled);
+  // The script polls base.log for the caster's port: a log left by an earlier run must not answer first (the base's
+  // own redirection truncates it only once its process has started).
+  fs::remove(dir / "base.log");
   // canyon-base waits for one client, str2str pulls the mount point (NTRIP 1) into a file.
   const std::string script =
       "cd " + dir.string() + "; " + kBase +

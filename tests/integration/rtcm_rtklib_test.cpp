@@ -295,6 +295,7 @@ fs::path str2str_rtcm(const fs::path& ubx_gz, const fs::path& dir,
       .write(reinterpret_cast<const char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()));
   fs::path out = dir / "str2str.rtcm3";
   const fs::path log = dir / "str2str.log";
+  fs::remove(log);  // polled below: a log of an earlier run would stop str2str at once
   // str2str does not exit at the end of a file: stop it once it reports the input ended.
   const std::string command = "bash -c 'str2str -in \"file://" + ubx.string() + "#ubx\" -out \"file://" + out.string() +
                               "#rtcm3\" -msg \"" + msg + "\" -p 53.2804778 -9.0578437 79.05 2> " + log.string() +
