@@ -15,7 +15,7 @@ packages=(
   libreaderwriterqueue-dev
   # deployment (issue 8): link emulator, namespaces, DDS-Security test PKI, dashboard server and its browser test
   libnetfilter-queue-dev iptables iproute2 iputils-ping openssl python3
-  libcpp-httplib-dev nlohmann-json3-dev chromium nodejs
+  libcpp-httplib-dev nlohmann-json3-dev chromium python3-websocket nodejs
 )
 
 # One dpkg-query call for all packages; a package dpkg has never heard of prints nothing and counts as missing.
