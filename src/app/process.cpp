@@ -281,7 +281,7 @@ Status run_staged(EpochEstimator& estimator, ObservationStream& rover, BaseCurso
 Status run_rtk(const ProcessConfig& config, const gnss::EphemerisStore& ephemerides, ObservationStream& rover,
                BaseCursor& base, const Eigen::Vector3d& p_E_base, Outputs& writer, ProcessSummary& summary,
                const ProgressFn& progress, const PipelineOptions& pipeline) {
-  rtk::RtkEngine engine(config.rtk, ephemerides, p_E_base);
+  rtk::RtkEngine engine(config.rtk_engine_options(), ephemerides, p_E_base);
   RtkEstimator estimator(engine);
   return run_staged(estimator, rover, base, writer, summary, progress, pipeline);
 }
@@ -394,7 +394,7 @@ Status run_fusion(const ProcessConfig& config, const gnss::EphemerisStore& ephem
   if (!track) return track.error();
   const core::GpsTime vio_first = track->first_time();
   const core::GpsTime vio_last = track->last_time();
-  fusion::FusionEngine engine(config.fusion, config.rtk, ephemerides, p_E_base, std::move(*track));
+  fusion::FusionEngine engine(config.fusion, config.rtk_engine_options(), ephemerides, p_E_base, std::move(*track));
   FusionEstimator estimator(engine);
   std::optional<core::GpsTime> first;
   core::GpsTime last;

@@ -279,6 +279,21 @@ std::string ProcessConfig::validate() const {
   return {};
 }
 
+rtk::RtkOptions ProcessConfig::rtk_engine_options() const {
+  rtk::RtkOptions o = rtk;
+  o.spp = spp;
+  for (const core::SatelliteId& sat : rtk.observables.excluded) {
+    if (std::find(o.spp.excluded.begin(), o.spp.excluded.end(), sat) == o.spp.excluded.end()) {
+      o.spp.excluded.push_back(sat);
+    }
+  }
+  for (const core::SatelliteId& sat : spp.excluded) {
+    std::vector<core::SatelliteId>& excluded = o.observables.excluded;
+    if (std::find(excluded.begin(), excluded.end(), sat) == excluded.end()) excluded.push_back(sat);
+  }
+  return o;
+}
+
 bool operator==(const ProcessConfig& a, const ProcessConfig& b) {
   return to_yaml(a) == to_yaml(b);
 }

@@ -350,8 +350,8 @@ int run(int argc, char** argv) {
       spdlog::error("{}", track.error().to_string());
       return kExitRuntime;
     }
-    fusion_engine =
-        std::make_unique<canyon::fusion::FusionEngine>(est.fusion, est.rtk, ephemerides, p_E_base, std::move(*track));
+    fusion_engine = std::make_unique<canyon::fusion::FusionEngine>(est.fusion, est.rtk_engine_options(), ephemerides,
+                                                                   p_E_base, std::move(*track));
     if (config->vio_dds) {
       auto readers = open_live_vio(*config, **participant, *fusion_engine, live_vio, vio_reader, timesync_reader);
       if (!readers) {
@@ -361,7 +361,7 @@ int run(int argc, char** argv) {
     }
     estimator = std::make_unique<app::FusionEstimator>(*fusion_engine, live_vio.get());
   } else {
-    rtk_engine = std::make_unique<canyon::rtk::RtkEngine>(est.rtk, ephemerides, p_E_base);
+    rtk_engine = std::make_unique<canyon::rtk::RtkEngine>(est.rtk_engine_options(), ephemerides, p_E_base);
     estimator = std::make_unique<app::RtkEstimator>(*rtk_engine);
   }
   app::EphemerisFeed feed(*estimator, ephemerides);

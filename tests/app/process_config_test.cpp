@@ -118,6 +118,33 @@ rtk: {ar_mode: fix_and_hold, frequencies: 1, systems: [G, R], glonass_ar: on, io
   }
 }
 
+// The RTK engine's single-point solution is the one `spp:` configures (it was left at SppOptions' defaults before:
+// the satellite-exclusion experiment's excluded satellites still fed canyon rtk's prior), and an exclusion in either
+// section holds for both.
+TEST(ProcessConfigTest, RtkEngineUsesTheSppSectionAndBothExclusions) {
+  auto config = parse(R"(
+mode: rtk
+base: /data/base.obs
+spp: {elevation_mask_deg: 20, systems: [G], ionosphere: off, exclude: [G05]}
+rtk: {systems: [G, E], exclude: [E11]}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  const rtk::RtkOptions o = config->rtk_engine_options();
+  EXPECT_NEAR(o.spp.elevation_mask_rad, 20.0 * core::kDegToRad, 1e-12);
+  EXPECT_TRUE(o.spp.use_gps);
+  EXPECT_FALSE(o.spp.use_galileo);
+  EXPECT_FALSE(o.spp.ionosphere_klobuchar);
+  const auto names = [](const std::vector<core::SatelliteId>& sats) {
+    std::string out;
+    for (const core::SatelliteId& s : sats) out += s.to_string() + " ";
+    return out;
+  };
+  EXPECT_EQ(names(o.spp.excluded), "G05 E11 ");
+  EXPECT_EQ(names(o.observables.excluded), "E11 G05 ");
+  EXPECT_TRUE(o.observables.use_galileo);                      // the RTK's own systems stay
+  EXPECT_EQ(names(config->rtk.observables.excluded), "E11 ");  // the sections themselves are not changed
+}
+
 TEST(ProcessConfigTest, PrintsAndParsesBackEqual) {
   auto config = parse(R"(
 mode: spp

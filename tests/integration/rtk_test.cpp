@@ -199,6 +199,37 @@ TEST(RtkSimulator, InstinctDynamicRoverWithTheConstantAccelerationModel) {
   EXPECT_EQ(stats->wrong_fixes, 0);
 }
 
+TEST(RtkSimulator, ExcludedSatellitesNeverReachTheSinglePointPrior) {
+  // GPS only, the most observed satellites left out: the RTK engine's single-point prior is the one `spp:`
+  // configures, exclusions included. With 4 left it has a position every epoch; with 3 left none can be formed, so
+  // no epoch is solved (before, the prior came from SppOptions' defaults with every satellite: 601 solutions, 94 %
+  // "fixed" on two double differences).
+  REQUIRE_DATA("instinct-spirent-rtk-sim");
+  const Eigen::Vector3d base(4157177.06580187, 671230.476590636, 4774767.03105544);
+  const std::string dir = "instinct-spirent-rtk-sim/iono-Klob_tropo-Saast/";
+  for (const int excluded : {4, 5}) {
+    auto run =
+        run_rtk("gps_excluded_" + std::to_string(excluded), dir + "Rover-dynamic_MO_Spirent.obs",
+                dir + "Base-static_MO_Spirent.obs",
+                {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
+                base, [excluded](app::ProcessConfig& c) {
+                  c.spp.use_glonass = c.spp.use_galileo = c.spp.use_beidou = c.spp.use_qzss = false;
+                  c.rtk.observables.use_glonass = c.rtk.observables.use_galileo = false;
+                  c.rtk.observables.use_beidou = c.rtk.observables.use_qzss = false;
+                  c.exclude_most_observed = excluded;
+                });
+    ASSERT_TRUE(run.has_value());
+    std::cout << "[ RTK      ] instinct dynamic, GPS, " << excluded
+              << " most observed left out: " << run->summary.solved << "/" << run->summary.epochs << " solved\n";
+    EXPECT_EQ(run->summary.epochs, 601);
+    if (excluded == 4) {
+      EXPECT_GE(run->summary.solved, 570);  // 579: a few epochs have 3 of the 4 above the mask
+    } else {
+      EXPECT_EQ(run->summary.solved, 0);
+    }
+  }
+}
+
 /// cssrlib-kinematic-doy265: fix rate at least RTKLIB's in the same AR mode, fixed positions within 3 cm of
 /// RTKLIB's where both are fixed (RTKLIB's results are the ones shipped with the dataset).
 TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {

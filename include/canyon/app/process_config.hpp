@@ -65,6 +65,10 @@ struct ProcessConfig {
 
   /// Empty if complete and consistent, else the first violated rule ("rover observation file is required").
   [[nodiscard]] std::string validate() const;
+
+  /// The RTK engine's options (rtk and fusion modes): `rtk` with its single-point solution (the prior, the fallback,
+  /// fusion's integrity reference) configured by `spp`, and a satellite excluded in either section left out of both.
+  [[nodiscard]] rtk::RtkOptions rtk_engine_options() const;
 };
 
 [[nodiscard]] bool operator==(const ProcessConfig& a, const ProcessConfig& b);
