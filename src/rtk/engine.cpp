@@ -862,6 +862,31 @@ bool RtkEngine::agrees_with_last_fix(const Fix& fix) const {
   return true;
 }
 
+int RtkEngine::fixable_directions(const std::vector<std::pair<int, int>>& dd) const {
+  // Satellites joined by their pairs: each pair merges the groups of its two satellites (a union-find over few).
+  std::vector<SatelliteId> sats;
+  std::vector<int> group;
+  const auto node = [&](const SatelliteId& sat) {
+    const auto it = std::find(sats.begin(), sats.end(), sat);
+    if (it != sats.end()) return static_cast<int>(it - sats.begin());
+    sats.push_back(sat);
+    group.push_back(static_cast<int>(group.size()));
+    return static_cast<int>(group.size()) - 1;
+  };
+  const auto root = [&](int i) {
+    while (group[static_cast<std::size_t>(i)] != i) i = group[static_cast<std::size_t>(i)];
+    return i;
+  };
+  for (const auto& [s, r] : dd) {
+    const int a = node(satellite_of_state(s));
+    const int b = node(satellite_of_state(r));
+    group[static_cast<std::size_t>(root(a))] = root(b);
+  }
+  int groups = 0;
+  for (std::size_t i = 0; i < group.size(); ++i) groups += root(static_cast<int>(i)) == static_cast<int>(i) ? 1 : 0;
+  return static_cast<int>(sats.size()) - groups;
+}
+
 RtkEngine::DdKey RtkEngine::dd_key(const std::pair<int, int>& dd) const {
   const auto k = static_cast<std::size_t>(num_kinematic_states());
   return {ambiguity_keys_[static_cast<std::size_t>(dd.first) - k],
@@ -1044,6 +1069,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   const auto all = dd_ambiguities(sds, Exclusion{});
   if (static_cast<int>(all.size()) < options_.min_fix_ambiguities) {
     out.note = "too few ambiguities to fix: " + std::to_string(all.size());
+    return false;
+  }
+  if (fixable_directions(all) < 3) {
+    out.note = "too few satellites to fix: their double differences leave the position open along a line";
     return false;
   }
   // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the

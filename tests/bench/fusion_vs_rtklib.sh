@@ -12,7 +12,8 @@
 #     without the heading error state, without the integrity check, without the heading-free fill-in.
 #  3. instinct-spirent-rtk-sim (real receiver-simulator GNSS files, 1 Hz, truth with attitude) with VIO from its truth
 #     (`canyon simulate --vio-from-truth`), the 5 and then 10 most observed satellites excluded, GPS+Galileo for canyon
-#     (RTKLIB 2.4.3 reads no Galileo record of these navigation files: GPS only), and GPS only for all three.
+#     (RTKLIB 2.4.3 reads no Galileo record of these navigation files: GPS only), and GPS only for all three (also 4
+#     excluded: with 5 out of GPS's 8 no program has a position).
 # Usage: tests/bench/fusion_vs_rtklib.sh [BUILD_DIR] [SEEDS] [SCENARIOS...]
 #   defaults: build, "1 2 3", light-blocked urban-severe
 # Environment: KEEP=1 keeps the temp folder (solutions, evaluation.md/json, trajectory.svg, ape.svg per run) and
@@ -197,7 +198,10 @@ if [[ ${INSTINCT:-1} != 0 ]]; then
   printf '%-10s %8s | %-30s | %-30s | %-30s | %7s %7s\n' systems excluded RTKLIB "canyon rtk" "canyon fusion" \
     rtklib_s fusion_s
   for systems in "G, E" "G"; do
-    for n in 0 5 10; do
+    # GPS alone has 8 satellites: with 5 out no one can form a position; 4 out leaves four, three at the end.
+    counts="0 5 10"
+    [[ $systems == G ]] && counts="0 4 5 10"
+    for n in $counts; do
       dir=$tmp/instinct-${systems//[ ,]/}-$n
       mkdir -p "$dir"
       for mode in rtk fusion; do

@@ -325,6 +325,11 @@ class RtkEngine {
   /// False if a DD ambiguity also fixed at the last fix (no slip since) gets another integer: a fix that contradicts
   /// its predecessor is a wrong fix of one of them, and is not taken.
   [[nodiscard]] bool agrees_with_last_fix(const Fix& fix) const;
+  /// How many directions of the position the DD ambiguities `dd` can pin once fixed, at most: each is a satellite
+  /// pair (s, reference), so with V satellites joined into C groups by the pairs, V - C (three satellites: 2). An
+  /// epoch whose fixable ambiguities give fewer than 3 is not fixed: the position would stay open along a line, held
+  /// there by the prior alone (single point, motion model or VIO), which makes no fixed solution.
+  [[nodiscard]] int fixable_directions(const std::vector<std::pair<int, int>>& dd) const;
   /// Drops the satellite with the largest integer least-squares residual contribution until a fix is accepted (at
   /// most max_pruned_satellites); nullopt if none is.
   [[nodiscard]] std::optional<Fix> prune(Fix fix, int min_size) const;
