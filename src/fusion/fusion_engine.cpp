@@ -592,7 +592,7 @@ std::vector<std::string> FusionEngine::report() const {
   lines.push_back(format("fusion: false-fix guard fired in %.0f epochs (%.0f candidate fixes); %.0f fixes after ILS "
                          "pruning; %.0f DD rows gated",
                          s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
-                  format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of an undetermined position",
+                  format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of a poorly determined position",
                          s.cn0_screened, s.undetermined_fix_epochs));
   if (options_.heading_state) {
     lines.push_back(

@@ -39,7 +39,8 @@
 //     integer least-squares residual and solves again (Algorithm 1, lines 13-19; rtk partial_ar). Beyond the paper,
 //     a false-fix guard rejects a candidate fix whose position disagrees with the prior:
 //     (p_fix - p_prior)^T (P_prior + P_fix)^-1 (p_fix - p_prior) > false_fix_chi2, and a fix whose position sigma
-//     (largest axis of P_fix) exceeds max_fix_sigma_m (integers fixed, position not: three satellites).
+//     (largest axis of P_fix) exceeds max_fix_sigma_m (a weak geometry; with fewer than 4 satellites the engine
+//     tries no fix at all).
 //  7. Output: fixed, else float (Algorithm 1).
 //  8. Beyond the paper, an integrity check (integrity_check): the horizontal offset of the epoch's single-point
 //     solution from the output, in local east and north, is kept over integrity_window_s of aided epochs; when the
@@ -125,7 +126,7 @@ struct FusionOptions {
   bool false_fix_guard = true;           ///< beyond the paper: fixes must agree with the prior
   double false_fix_chi2 = 16.27;         ///< chi-square(3) bound of the guard (0.999)
   double max_fix_sigma_m = 0.1;          ///< a fix whose position sigma (largest axis) exceeds this is not taken:
-                                         ///< its DD geometry leaves the position undetermined (too few satellites)
+                                         ///< its DD geometry leaves the position poorly determined
   Cn0ScreenOptions cn0;                  ///< beyond the paper: NLOS screening by C/N0 (cn0_screen.hpp)
   int max_prior_rejections = 5;          ///< after this many consecutive epochs whose float failed only the prior
                                          ///< check, the float is taken: GNSS re-anchors a drifted VIO prior
@@ -171,7 +172,7 @@ struct FusionStats {
   int guard_candidates = 0;         ///< candidate fixes it rejected
   int gated_rows = 0;               ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
   int cn0_screened = 0;             ///< signals removed by the C/N0 screen
-  int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its undetermined position
+  int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its position sigma
   int ar_pruned_epochs = 0;         ///< fixes obtained after pruning satellites by their ILS residual
   int reanchored = 0;               ///< floats taken after max_prior_rejections (the prior had drifted)
   int widened = 0;                  ///< priors widened after gate_conflict_epochs

@@ -54,7 +54,9 @@
 // innovations are also gated by the aiding's thresholds; a fix is accepted only if the aiding's accept_fix agrees; and
 // the prior is kept so that revert_to_prior() can undo the epoch's measurement update and ambiguity resolution.
 //
-// Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA; a fix is accepted when it passes
+// Ambiguity resolution: SD -> DD per group against the group's reference, MLAMBDA; none is tried when the fixable
+// ambiguities come from fewer than 4 satellites (fixable_directions() < 3: the integers would leave the position open
+// along a line, held there by the prior alone, which makes no fixed solution); a fix is accepted when it passes
 // the ratio test, the bootstrapped success rate of the float covariance reaches min_success_rate (the ratio test
 // alone accepts wrong single-frequency, single-epoch fixes), and no DD ambiguity also fixed at the last fix (no slip
 // since) gets another integer. The fixed position from the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix).
