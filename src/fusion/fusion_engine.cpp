@@ -405,6 +405,7 @@ FusionEpoch FusionEngine::finish_epoch() {
     } else {
       out.solution = result->solution;
       if (!result->ar_pruned.empty() && out.solution.status == core::SolutionStatus::Fixed) ++stats_.ar_pruned_epochs;
+      if (result->too_few_to_fix) ++stats_.too_few_to_fix;
     }
   } else {
     out.solution = result->solution;
@@ -593,7 +594,8 @@ std::vector<std::string> FusionEngine::report() const {
                          "pruning; %.0f DD rows gated",
                          s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
                   format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of a poorly determined position",
-                         s.cn0_screened, s.undetermined_fix_epochs));
+                         s.cn0_screened, s.undetermined_fix_epochs) +
+                  format("; %.0f epochs with fewer than 4 satellites to fix (no fix tried)", s.too_few_to_fix));
   if (options_.heading_state) {
     lines.push_back(
         format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "

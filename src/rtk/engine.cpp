@@ -1073,6 +1073,7 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   }
   if (fixable_directions(all) < 3) {
     out.note = "too few satellites to fix: their double differences leave the position open along a line";
+    out.too_few_to_fix = true;
     return false;
   }
   // A subset keeps at least min_partial_fraction of the ambiguities: the position of a small subset rests on the

@@ -164,6 +164,48 @@ TEST_F(RtkAidingTest, AnAidedEpochIsSolvedWithoutASinglePointSolution) {
   EXPECT_LT((r->solution.p_E_m - simulation_->truth[20].p_E_m).norm(), 0.5);
 }
 
+TEST_F(RtkAidingTest, NoFixFromFewerThanFourSatellites) {
+  // Fixed and held, then aided epochs with GPS satellites tracked on two frequencies only: three of them leave the
+  // position open along a line that only the prior holds, so no fix is tried however good the prior (their four DD
+  // ambiguities pass min_fix_ambiguities); all of them fix again.
+  RtkOptions hold = options();
+  hold.ar_mode = ArMode::FixAndHold;
+  RtkEngine engine(hold, *ephemerides_, simulation_->base_p_E_m);
+  run(engine, 20);
+  const auto two_frequency_gps = [](const core::SatelliteObs& s) {
+    const auto with_phase = std::count_if(s.signals.begin(), s.signals.end(), [](const core::SignalObs& signal) {
+      return core::has_value(signal.carrier_phase_cyc);
+    });
+    return s.sat.system == core::Constellation::Gps && with_phase >= 2;
+  };
+  int fixed_three = 0, too_few_three = 0, fixed_all = 0, too_few_all = 0;
+  for (int k = 20; k < 40; ++k) {
+    core::ObsEpoch e = simulation_->rover.epochs[static_cast<std::size_t>(k)];
+    std::erase_if(e.sats, [&](const core::SatelliteObs& s) { return !two_frequency_gps(s); });
+    ASSERT_GE(e.sats.size(), 5U);
+    // The highest three: well above the AR elevation mask.
+    const Eigen::Vector3d& p_E = simulation_->truth[static_cast<std::size_t>(k)].p_E_m;
+    const core::Geodetic at = core::ecef_to_geodetic(p_E);
+    const auto elevation = [&](const core::SatelliteObs& s) {
+      const auto state = ephemerides_->state(s.sat, e.time);
+      return state ? core::azimuth_elevation(p_E, at, state->p_E_m).elevation_rad : -1.0;
+    };
+    std::sort(e.sats.begin(), e.sats.end(),
+              [&](const core::SatelliteObs& l, const core::SatelliteObs& r) { return elevation(l) > elevation(r); });
+    if (k < 30) e.sats.resize(3);
+    const RtkAiding a = truth_aiding(k, 0.001);
+    auto r = engine.process(e, base_at(e.time), &a);
+    ASSERT_TRUE(r.ok()) << r.error().to_string();
+    const bool fixed = r->solution.status == core::SolutionStatus::Fixed;
+    (k < 30 ? fixed_three : fixed_all) += fixed ? 1 : 0;
+    (k < 30 ? too_few_three : too_few_all) += r->too_few_to_fix ? 1 : 0;
+  }
+  EXPECT_EQ(fixed_three, 0);
+  EXPECT_EQ(too_few_three, 10);
+  EXPECT_EQ(too_few_all, 0);
+  EXPECT_GT(fixed_all, 5);
+}
+
 TEST_F(RtkAidingTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
   RtkOptions o = options();
   o.aiding_heading_state = true;

@@ -181,6 +181,7 @@ struct RtkEpoch {
   double max_post_fit_normalised = 0.0;      ///< largest DD post-fit residual (phase or code) over its rejection
                                              ///< threshold (max_post_fit_sigmas or _code_sigmas) after rejections
   std::vector<core::SatelliteId> ar_pruned;  ///< satellites partial fixing pruned by their ILS residual
+  bool too_few_to_fix = false;  ///< the fixable ambiguities came from fewer than 4 satellites: no fix was tried
   // Aided epochs: the prior (after the time update with the aiding).
   bool aided = false;
   Eigen::Vector3d prior_p_E_m = Eigen::Vector3d::Zero();
