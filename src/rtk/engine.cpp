@@ -910,6 +910,8 @@ std::string RtkEngine::rejection_reason(const Fix& fix) const {
 }
 
 bool RtkEngine::accepted(const Fix& fix) const {
+  // A subset (partial fixing) from fewer than 4 satellites leaves the position open as the whole epoch's would.
+  if (!fix.combinations && fixable_directions(fix.dd) < 3) return false;
   if (!agrees_with_last_fix(fix)) return false;
   if (!(fix.ratio >= options_.ratio_threshold && fix.success_rate >= options_.min_success_rate)) return false;
   if (aiding_ != nullptr && aiding_->accept_fix) {
