@@ -13,6 +13,7 @@ import argparse
 import base64
 import json
 import re
+import signal
 import subprocess
 import sys
 import threading
@@ -34,12 +35,17 @@ class DevTools:
              "--user-data-dir=" + profile, url],
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         self.stderr_tail = []
-        port = self._port(wait_s)
-        # Keep reading Chromium's stderr (its last lines for the report): a full pipe would block it.
-        threading.Thread(target=self._drain, daemon=True).start()
-        page = self._page_target(port, url, wait_s)
-        self.socket = websocket.create_connection(page["webSocketDebuggerUrl"], timeout=30)
+        self.socket = None
         self.next_id = 0
+        try:
+            port = self._port(wait_s)
+            # Keep reading Chromium's stderr (its last lines for the report): a full pipe would block it.
+            threading.Thread(target=self._drain, daemon=True).start()
+            page = self._page_target(port, url, wait_s)
+            self.socket = websocket.create_connection(page["webSocketDebuggerUrl"], timeout=30)
+        except BaseException:
+            self.close()
+            raise
 
     def _drain(self):
         for line in self.process.stderr:
@@ -86,7 +92,8 @@ class DevTools:
 
     def close(self):
         try:
-            self.socket.close()
+            if self.socket is not None:
+                self.socket.close()
         finally:
             self.process.terminate()
             try:
@@ -116,6 +123,8 @@ def main():
     p.add_argument("--gap", type=float, default=3.0, help="seconds between the two readings")
     p.add_argument("--wait", type=float, default=60.0, help="seconds to wait for Chromium and the first snapshot")
     args = p.parse_args()
+    # A timeout's SIGTERM unwinds through the finally blocks, which stop Chromium.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(1))
     try:
         page = DevTools(args.chromium, args.url, args.profile, args.wait)
     except (RuntimeError, OSError, websocket.WebSocketException) as e:
