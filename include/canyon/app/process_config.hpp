@@ -17,7 +17,7 @@
 //   output:
 //     coordinates: llh             # llh | ecef
 //     time_format: tow             # tow (GPST week, seconds) | calendar (yyyy/mm/dd hh:mm:ss.sss)
-//   spp:
+//   spp:                           # the single point: spp mode's solution, the RTK engine's prior and fallback
 //     elevation_mask_deg: 15       # deg
 //     systems: [G, R, E, C, J]     # constellations to use
 //     ionosphere: klobuchar        # klobuchar | off
@@ -26,7 +26,7 @@
 //     raim_fde: true               # exclude one faulty satellite when the chi-square test fails
 //     max_gdop: 30                 # reject solutions with a larger GDOP
 //     qzss_own_clock: false        # false: QZSS shares the GPS receiver clock
-//     exclude: [G05]               # satellites never used
+//     exclude: [G05]               # satellites never used (rtk: exclude likewise keeps them out of both)
 //   rtk:                           # see config/rtk.yaml for every key with its unit and default
 //   fusion:                        # see config/fusion.yaml for every key with its unit and the paper's defaults
 
