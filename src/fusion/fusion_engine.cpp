@@ -342,7 +342,7 @@ FusionEpoch FusionEngine::finish_heading_free() {
   FusionEpoch out;
   out.solution = *heading_free_epoch_;
   heading_free_epoch_.reset();
-  out.note = "VIO fill-in before an alignment: the heading unknown";
+  out.note = "before an alignment: the heading unknown";  // the status says VIO fill-in
   ++stats_.heading_free;
   spp_offsets_.clear();
   pending_alignment_ = PendingAlignment{epoch_time_, epoch_pose_};
@@ -400,7 +400,7 @@ FusionEpoch FusionEngine::finish_epoch() {
       s.p_E_m = result->aided ? result->prior_p_E_m : prior_->p_E_m;
       s.P_E_m2 = result->aided ? result->prior_P_E_m2 : prior_->P_E_m2;
       s.ratio = 0.0;
-      out.note = "VIO fill-in: " + invalid;
+      out.note = invalid;  // the status says VIO fill-in
       ++stats_.fill_in;
     } else {
       out.solution = result->solution;

@@ -906,7 +906,9 @@ std::string RtkEngine::rejection_reason(const Fix& fix) const {
                 static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate);
   if (fix.ratio < options_.ratio_threshold) return std::string("ratio test failed") + numbers;
   if (fix.success_rate < options_.min_success_rate) return std::string("success rate too low") + numbers;
-  return std::string("contradicts the last fix") + numbers;
+  if (!agrees_with_last_fix(fix)) return std::string("contradicts the last fix") + numbers;
+  if (!fix.combinations && fixable_directions(fix.dd) < 3) return std::string("fewer than 4 satellites") + numbers;
+  return std::string("refused by the aiding (its false-fix guard or position check)") + numbers;
 }
 
 bool RtkEngine::accepted(const Fix& fix) const {
