@@ -74,6 +74,7 @@ void parse_rtk(YamlMap map, rtk::RtkOptions& o) {
   map.get("partial_ar", o.partial_ar);
   map.get("max_pruned_satellites", o.max_pruned_satellites);
   map.get("min_success_rate", o.min_success_rate);
+  map.get("float_consistency_level", o.float_consistency_level);
   map.get("min_partial_fraction", o.min_partial_fraction);
   std::string glonass_ar = o.glonass_ar ? "on" : "off";
   map.get("glonass_ar", glonass_ar);
@@ -395,6 +396,7 @@ static void emit_rtk(YAML::Emitter& out, const rtk::RtkOptions& o) {
   out << YAML::Key << "partial_ar" << YAML::Value << o.partial_ar;
   out << YAML::Key << "max_pruned_satellites" << YAML::Value << o.max_pruned_satellites;
   out << YAML::Key << "min_success_rate" << YAML::Value << o.min_success_rate;
+  out << YAML::Key << "float_consistency_level" << YAML::Value << o.float_consistency_level;
   out << YAML::Key << "min_partial_fraction" << YAML::Value << o.min_partial_fraction;
   out << YAML::Key << "glonass_ar" << YAML::Value << (o.glonass_ar ? "on" : "off");
   out << YAML::Key << "dynamics" << YAML::Value << o.dynamics;

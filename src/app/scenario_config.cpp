@@ -194,6 +194,7 @@ void parse_receiver(YamlMap map, sim::ReceiverOptions& o) {
 
 void parse_reflections(YamlMap map, sim::ReflectionOptions& o) {
   map.get("multipath", o.multipath);
+  map.get("nlos", o.nlos);
   map.get("wall_loss_db", o.wall_loss_db);
   map.get("nlos_extra_loss_db", o.nlos_extra_loss_db);
   map.get("ground_loss_db", o.ground_loss_db);
@@ -419,6 +420,7 @@ void write_scenario_body(Writer& w, const Scenario& s) {
   write_receiver(w, "base_receiver", s.base_receiver);
   w.section("reflections");
   w.flag("multipath", s.reflections.multipath);
+  w.flag("nlos", s.reflections.nlos);
   w.key("wall_loss_db", s.reflections.wall_loss_db);
   w.key("nlos_extra_loss_db", s.reflections.nlos_extra_loss_db);
   w.key("ground_loss_db", s.reflections.ground_loss_db);

@@ -406,6 +406,7 @@ FusionEpoch FusionEngine::finish_epoch() {
       out.solution = result->solution;
       if (!result->ar_pruned.empty() && out.solution.status == core::SolutionStatus::Fixed) ++stats_.ar_pruned_epochs;
       if (result->too_few_to_fix) ++stats_.too_few_to_fix;
+      if (result->float_variance_factor > 1.0) ++stats_.float_inconsistent;
     }
   } else {
     out.solution = result->solution;
@@ -590,12 +591,14 @@ std::vector<std::string> FusionEngine::report() const {
       format("fusion: float validation failed: %.0f no DD phase, %.0f post-fit residuals, %.0f "
              "inconsistent with the VIO prior",
              s.float_rejected_no_phase, s.float_rejected_post_fit, s.float_rejected_prior));
-  lines.push_back(format("fusion: false-fix guard fired in %.0f epochs (%.0f candidate fixes); %.0f fixes after ILS "
-                         "pruning; %.0f DD rows gated",
-                         s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
-                  format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of a poorly determined position",
-                         s.cn0_screened, s.undetermined_fix_epochs) +
-                  format("; %.0f epochs with fewer than 4 satellites to fix (no fix tried)", s.too_few_to_fix));
+  lines.push_back(
+      format("fusion: false-fix guard fired in %.0f epochs (%.0f candidate fixes); %.0f fixes after ILS "
+             "pruning; %.0f DD rows gated",
+             s.guard_epochs, s.guard_candidates, s.ar_pruned_epochs, s.gated_rows) +
+      format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of a poorly determined position",
+             s.cn0_screened, s.undetermined_fix_epochs) +
+      format("; %.0f epochs with fewer than 4 satellites to fix (no fix tried)", s.too_few_to_fix) +
+      format("; %.0f epochs whose float fit no integer vector (success rates scaled)", s.float_inconsistent));
   if (options_.heading_state) {
     lines.push_back(
         format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "

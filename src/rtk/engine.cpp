@@ -12,6 +12,7 @@
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/statistics.hpp"
 #include "canyon/gnss/atmosphere.hpp"
 #include "canyon/rtk/lambda.hpp"
 
@@ -331,6 +332,9 @@ std::string RtkOptions::validate() const {
   if (!(ratio_threshold >= 1.0)) return "ratio_threshold must be >= 1";
   if (min_fix_ambiguities < 1) return "min_fix_ambiguities must be >= 1";
   if (!(min_success_rate >= 0.0 && min_success_rate <= 1.0)) return "min_success_rate must be in [0, 1]";
+  if (!(float_consistency_level >= 0.0 && float_consistency_level < 0.5)) {
+    return "float_consistency_level must be in [0, 0.5) (0: no test)";
+  }
   if (!(min_partial_fraction >= 0.0 && min_partial_fraction <= 1.0)) return "min_partial_fraction must be in [0, 1]";
   if (!(max_partial_fix_sigma_m > 0.0)) return "max_partial_fix_sigma_m must be > 0";
   if (!(snr_reference_dbhz > 0.0)) return "snr_reference_dbhz must be > 0";
@@ -352,7 +356,10 @@ RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides
     : options_(std::move(options)),
       eph_(ephemerides),
       p_E_base_m_(std::move(p_E_base_m)),
-      geometry_builder_(geometry_options(), eph_, p_E_base_m_) {
+      geometry_builder_(geometry_options(), eph_, p_E_base_m_),
+      consistency_z_(options_.float_consistency_level > 0.0
+                         ? core::normal_upper_quantile(options_.float_consistency_level)
+                         : 0.0) {
   x_ = Eigen::VectorXd::Zero(num_kinematic_states());
   P_ = Eigen::MatrixXd::Zero(num_kinematic_states(), num_kinematic_states());
 }
@@ -671,13 +678,11 @@ int RtkEngine::update_once(std::vector<SingleDiff>& sds, std::vector<core::Satel
         // The SD residuals were formed at the prior position: the geometry term is already in observed_m, and
         // the position correction enters through H; at the prior, the predicted DD range residual is zero.
         row.innovation_m = observed_m - predicted_m;
-        double gate = phase ? options_.max_phase_innovation_m : options_.max_code_innovation_m;
-        if (std::abs(row.innovation_m) > gate) {
+        const double gate = phase ? options_.max_phase_innovation_m : options_.max_code_innovation_m;
+        if (std::abs(row.innovation_m) > gate || (aiding_ != nullptr && !aided_gate_passes(*aiding_, row, sds, P_))) {
           rejected.push_back(sd.sat);
-          continue;
-        }
-        if (aiding_ != nullptr && !aided_gate_passes(*aiding_, row, sds, P_)) {
-          rejected.push_back(sd.sat);
+          // Its ambiguity is not updated by this epoch: not fixed either (the prior's integer is no fix).
+          if (phase) sds[static_cast<std::size_t>(i)].fixable = false;
           continue;
         }
         rows.push_back(std::move(row));
@@ -846,11 +851,23 @@ std::optional<RtkEngine::Fix> RtkEngine::try_fix(const std::vector<std::pair<int
   if (!search) return std::nullopt;
   fix.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
   fix.squared_norm = search->squared_norms[0];
-  fix.success_rate = bootstrap_success_rate(search->conditional_variances);
+  fix.success_rate = success_rate(search->conditional_variances);
   fix.a_fix = search->candidates.col(0);
   fix.Z = std::move(search->Z);
   fix.d = std::move(search->conditional_variances);
   return fix;
+}
+
+double RtkEngine::success_rate(const Eigen::VectorXd& d) const {
+  return float_variance_factor_ > 1.0 ? bootstrap_success_rate(d * float_variance_factor_) : bootstrap_success_rate(d);
+}
+
+void RtkEngine::test_float_consistency(Fix& full) {
+  if (!(consistency_z_ > 0.0)) return;
+  const auto n = static_cast<double>(full.a_fix.size());
+  if (!(full.squared_norm > core::chi_square_upper_quantile(n, consistency_z_))) return;
+  float_variance_factor_ = full.squared_norm / n;
+  full.success_rate = success_rate(full.d);
 }
 
 bool RtkEngine::agrees_with_last_fix(const Fix& fix) const {
@@ -901,9 +918,17 @@ std::vector<RtkEngine::DdKey> RtkEngine::dd_keys(const std::vector<std::pair<int
 }
 
 std::string RtkEngine::rejection_reason(const Fix& fix) const {
-  char numbers[96];
-  std::snprintf(numbers, sizeof numbers, " (%d ambiguities, ratio %.1f, success rate %.3f)",
-                static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate);
+  char numbers[160];
+  if (float_variance_factor_ > 1.0) {
+    std::snprintf(
+        numbers, sizeof numbers,
+        " (%d ambiguities, ratio %.1f, success rate %.3f with the float covariance scaled by %.1f: no integer "
+        "vector fits the float)",
+        static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate, float_variance_factor_);
+  } else {
+    std::snprintf(numbers, sizeof numbers, " (%d ambiguities, ratio %.1f, success rate %.3f)",
+                  static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate);
+  }
   if (fix.ratio < options_.ratio_threshold) return std::string("ratio test failed") + numbers;
   if (fix.success_rate < options_.min_success_rate) return std::string("success rate too low") + numbers;
   if (!agrees_with_last_fix(fix)) return std::string("contradicts the last fix") + numbers;
@@ -996,7 +1021,7 @@ std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full
   double success = 1.0;
   Eigen::Index k0 = n;
   while (k0 > 0) {
-    const double with_next = success * bootstrap_success_rate(full.d.segment(k0 - 1, 1));
+    const double with_next = success * success_rate(full.d.segment(k0 - 1, 1));
     if (with_next < options_.min_success_rate) break;
     success = with_next;
     --k0;
@@ -1015,7 +1040,7 @@ std::optional<RtkEngine::Fix> RtkEngine::success_rate_subset_fix(const Fix& full
   if (!search) return std::nullopt;
   sub.ratio = ratio_test(*search, options_.ratio_threshold).ratio;
   sub.squared_norm = search->squared_norms[0];
-  sub.success_rate = bootstrap_success_rate(search->conditional_variances);
+  sub.success_rate = success_rate(search->conditional_variances);
   sub.a_fix = search->candidates.col(0);
   if (!accepted(sub)) return std::nullopt;
   // A few precise combinations need not pin the position down: the fix counts only if they do (otherwise the caller
@@ -1097,7 +1122,10 @@ bool RtkEngine::resolve_ambiguities(const std::vector<SingleDiff>& sds, RtkEpoch
   if (best) {
     out.solution.ratio = std::min(best->ratio, 999.9);
   } else {
+    float_variance_factor_ = 1.0;  // the full set is tested afresh: its own success rate unscaled first
     best = try_fix(all, options_.min_fix_ambiguities);
+    if (best) test_float_consistency(*best);
+    out.float_variance_factor = float_variance_factor_;
     epochs_since_full_set_ = 0;
     failed_full_set_.clear();
     if (best) out.solution.ratio = std::min(best->ratio, 999.9);

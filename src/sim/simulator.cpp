@@ -269,7 +269,7 @@ class ReceiverSimulator {
     const ReflectionOptions& refl = setup_.scenario->reflections;
     if (city->direct_blocked(ctx.p_N, ctx.u_N)) {
       p.direct = false;
-      p.nlos = city->wall_reflection(ctx.p_N, ctx.u_N, ctx.walls);
+      if (refl.nlos) p.nlos = city->wall_reflection(ctx.p_N, ctx.u_N, ctx.walls);
       return p;
     }
     p.foliage_m = city->foliage_m(ctx.p_N, ctx.u_N);

@@ -46,6 +46,7 @@ TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {
   expected_fusion.mode = ProcessMode::Fusion;
   expected_fusion.rtk.ar_mode = rtk::ArMode::FixAndHold;
   expected_fusion.rtk.ionosphere = rtk::IonosphereModel::Estimate;
+  expected_fusion.rtk.float_consistency_level = 0.001;
   EXPECT_EQ(to_yaml(*fusion), to_yaml(expected_fusion));
 }
 

@@ -28,6 +28,7 @@
 #include "canyon/fusion/time_bridge.hpp"
 #include "canyon/fusion/vio_prediction.hpp"
 #include "canyon/fusion/vio_track.hpp"
+#include "canyon/rtk/engine.hpp"
 #include "canyon/sim/simulator.hpp"
 #include "canyon/sim/vio.hpp"
 
@@ -443,12 +444,12 @@ struct Simulated {
   sim::Simulation sim;
 };
 
-/// The shipped urban-severe scenario cut to `duration_s`, simulated (its navigation file written to a temporary
-/// folder named after `tag`, removed again); nullopt after a test failure.
-std::optional<Simulated> simulate_urban_severe(double duration_s, const std::string& tag,
-                                               const sim::SimulationOptions& options = {},
-                                               std::optional<std::uint64_t> seed = std::nullopt) {
-  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/urban-severe.yaml").string());
+/// The shipped scenario `name` cut to `duration_s`, simulated (its navigation file written to a temporary folder named
+/// after `tag`, removed again); nullopt after a test failure.
+std::optional<Simulated> simulate_scenario(const std::string& name, double duration_s, const std::string& tag,
+                                           const sim::SimulationOptions& options = {},
+                                           std::optional<std::uint64_t> seed = std::nullopt) {
+  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios" / (name + ".yaml")).string());
   if (!scenario) {
     ADD_FAILURE() << scenario.error().to_string();
     return std::nullopt;
@@ -464,6 +465,12 @@ std::optional<Simulated> simulate_urban_severe(double duration_s, const std::str
     return std::nullopt;
   }
   return Simulated{std::move(*scenario), std::move(*sim)};
+}
+
+std::optional<Simulated> simulate_urban_severe(double duration_s, const std::string& tag,
+                                               const sim::SimulationOptions& options = {},
+                                               std::optional<std::uint64_t> seed = std::nullopt) {
+  return simulate_scenario("urban-severe", duration_s, tag, options, seed);
 }
 
 // --- C/N0 screen ----------------------------------------------------------------------------------------------------
@@ -546,17 +553,19 @@ TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
 struct FusionRun {
   double rmse_m = 0.0;  // 3D, every epoch with a solution
   int solved = 0;
+  int fixed = 0;
+  int wrong_fixes = 0;  // fixed epochs more than 0.10 m (3D) from the truth
   FusionStats stats;
 };
 FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
-                     const std::function<void(FusionOptions&)>& change) {
+                     const std::function<void(app::ProcessConfig&)>& change) {
   FusionRun run;
   auto config = app::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/fusion.yaml").string());
   if (!config) {
     ADD_FAILURE() << config.error().to_string();
     return run;
   }
-  change(config->fusion);
+  change(*config);
   const gnss::EphemerisStore eph(sim.nav);
   FusionEngine engine(config->fusion, config->rtk, eph, sim.base_p_E_m,
                       VioTrack::from_samples(track_samples(sim.vio.poses, start), start));
@@ -567,12 +576,21 @@ FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
     while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - e.time <= 0.05) ++base;
     auto out = engine.process(e, &sim.base.epochs[base]);
     if (!out || out->solution.status == core::SolutionStatus::None) continue;
-    sum2 += (out->solution.p_E_m - sim.truth[k].p_E_m).squaredNorm();
+    const double error2_m2 = (out->solution.p_E_m - sim.truth[k].p_E_m).squaredNorm();
+    sum2 += error2_m2;
     ++run.solved;
+    if (out->solution.status == core::SolutionStatus::Fixed) {
+      ++run.fixed;
+      if (error2_m2 > 0.1 * 0.1) ++run.wrong_fixes;
+    }
   }
   run.rmse_m = run.solved > 0 ? std::sqrt(sum2 / run.solved) : 0.0;
   run.stats = engine.stats();
   return run;
+}
+FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
+                     const std::function<void(FusionOptions&)>& change) {
+  return run_fusion(sim, start, [&change](app::ProcessConfig& config) { change(config.fusion); });
 }
 
 /// urban-severe (seed, duration) fused with config/fusion.yaml as it is and with one feature turned off.
@@ -638,6 +656,82 @@ TEST(FusionHeadingFreeTest, AStartInTheCanyonHasASolutionAtEveryEpoch) {
   EXPECT_GT(with.stats.heading_free, 100);
   EXPECT_EQ(without.stats.heading_free, 0);
   EXPECT_EQ(with.solved - without.solved, with.stats.heading_free);
+}
+
+// --- Float consistency (rtk::RtkOptions::float_consistency_level) ------------------------------------------------
+
+TEST(FloatConsistencyTest, AFloatThatFitsNoIntegersFixesNothingInAMidRiseCanyon) {
+  // urban-moderate, seed 7: walls 10 dB reflections beside the sidewalk give every line-of-sight code an error of
+  // metres that holds for minutes, which the filter takes as white noise; its float claims centimetres while it is
+  // decimetres off, its integer search finds no vector that fits (squared norms 10-20 times their number) and, with
+  // the success rate of that claimed covariance, fix-and-hold held a wrong set for minutes (901 wrong fixes).
+  auto simulated = simulate_scenario("urban-moderate", 600.0, "consistency", {}, 7);
+  ASSERT_TRUE(simulated);
+  const core::GpsTime start = simulated->scenario.start;
+  const FusionRun with = run_fusion(simulated->sim, start, [](app::ProcessConfig&) {});
+  const FusionRun without =
+      run_fusion(simulated->sim, start, [](app::ProcessConfig& c) { c.rtk.float_consistency_level = 0.0; });
+  std::printf(
+      "urban-moderate seed 7, 600 s: %d fixed, %d wrong with the float consistency test (%d epochs failed it); %d "
+      "fixed, %d wrong without\n",
+      with.fixed, with.wrong_fixes, with.stats.float_inconsistent, without.fixed, without.wrong_fixes);
+  EXPECT_GT(without.wrong_fixes, 100) << "the scenario no longer shows what the test is for";
+  EXPECT_LE(with.wrong_fixes, 0.01 * with.fixed);
+  EXPECT_GT(with.stats.float_inconsistent, 0);
+  EXPECT_EQ(without.stats.float_inconsistent, 0);
+  EXPECT_EQ(with.solved, without.solved);
+}
+
+TEST(FloatConsistencyTest, CanyonRtkTakesNoWrongFixesInAMidRiseCanyon) {
+  // The same test in canyon rtk (config/rtk-urban.yaml) on urban-moderate, seed 9: 27 wrong fixes without it.
+  auto simulated = simulate_scenario("urban-moderate", 600.0, "consistency-rtk", {}, 9);
+  ASSERT_TRUE(simulated);
+  const sim::Simulation& sim = simulated->sim;
+  auto config = app::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/rtk-urban.yaml").string());
+  ASSERT_TRUE(config) << config.error().to_string();
+  const gnss::EphemerisStore eph(sim.nav);
+  const auto wrong_fixes = [&](double level, int& fixed, int& inconsistent) {
+    rtk::RtkOptions options = config->rtk;
+    options.float_consistency_level = level;
+    rtk::RtkEngine engine(options, eph, sim.base_p_E_m);
+    std::size_t base = 0;
+    int wrong = 0;
+    for (std::size_t k = 0; k < sim.rover.epochs.size(); ++k) {
+      const core::ObsEpoch& e = sim.rover.epochs[k];
+      while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - e.time <= 0.05) ++base;
+      auto out = engine.process(e, &sim.base.epochs[base]);
+      if (!out) continue;
+      if (out->float_variance_factor > 1.0) ++inconsistent;
+      if (out->solution.status != core::SolutionStatus::Fixed) continue;
+      ++fixed;
+      if ((out->solution.p_E_m - sim.truth[k].p_E_m).norm() > 0.1) ++wrong;
+    }
+    return wrong;
+  };
+  int fixed_with = 0, fixed_without = 0, inconsistent_with = 0, inconsistent_without = 0;
+  const int with = wrong_fixes(config->rtk.float_consistency_level, fixed_with, inconsistent_with);
+  const int without = wrong_fixes(0.0, fixed_without, inconsistent_without);
+  std::printf(
+      "urban-moderate seed 9, 600 s, canyon rtk: %d fixed, %d wrong with the test (%d epochs failed it); %d "
+      "fixed, %d wrong without\n",
+      fixed_with, with, inconsistent_with, fixed_without, without);
+  EXPECT_GT(without, 10) << "the scenario no longer shows what the test is for";
+  EXPECT_LE(with, 0.01 * fixed_with);
+  EXPECT_GT(inconsistent_with, 0);
+  EXPECT_EQ(inconsistent_without, 0);
+}
+
+TEST(FloatConsistencyTest, OpenSkyFixesAreUnchanged) {
+  // Where the model holds, the test never fires: the same solutions, epoch for epoch.
+  auto simulated = simulate_scenario("light-blocked", 300.0, "consistency-open", {}, 1);
+  ASSERT_TRUE(simulated);
+  const core::GpsTime start = simulated->scenario.start;
+  const FusionRun with = run_fusion(simulated->sim, start, [](app::ProcessConfig&) {});
+  const FusionRun without =
+      run_fusion(simulated->sim, start, [](app::ProcessConfig& c) { c.rtk.float_consistency_level = 0.0; });
+  EXPECT_EQ(with.fixed, without.fixed);
+  EXPECT_DOUBLE_EQ(with.rmse_m, without.rmse_m);
+  EXPECT_GT(with.fixed, 0.9 * with.stats.epochs);
 }
 
 }  // namespace

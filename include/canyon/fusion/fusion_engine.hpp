@@ -174,6 +174,7 @@ struct FusionStats {
   int cn0_screened = 0;             ///< signals removed by the C/N0 screen
   int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its position sigma
   int too_few_to_fix = 0;           ///< aided epochs whose fixable ambiguities came from fewer than 4 satellites
+  int float_inconsistent = 0;       ///< aided epochs whose float failed the RTK engine's float consistency test
   int ar_pruned_epochs = 0;         ///< fixes obtained after pruning satellites by their ILS residual
   int reanchored = 0;               ///< floats taken after max_prior_rejections (the prior had drifted)
   int widened = 0;                  ///< priors widened after gate_conflict_epochs

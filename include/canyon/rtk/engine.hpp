@@ -60,6 +60,18 @@
 // the ratio test, the bootstrapped success rate of the float covariance reaches min_success_rate (the ratio test
 // alone accepts wrong single-frequency, single-epoch fixes), and no DD ambiguity also fixed at the last fix (no slip
 // since) gets another integer. The fixed position from the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix).
+// Float consistency (float_consistency_level): with a right model and right integers a, (a_float - a)^T Q_a^-1
+// (a_float - a) is chi-square with n degrees of freedom; when even the best integer vector of the full set leaves a
+// squared norm beyond the chi-square quantile of that level, no integer vector fits the float, whose covariance is too
+// optimistic (reflections and multipath, errors correlated over minutes that the filter takes as white noise). The
+// epoch's success rates (of the full set, its subsets and the pruned sets) are then computed with Q_a scaled by the
+// variance factor k = norm / n, its a-posteriori estimate: a float that claims centimetres while it is decimetres off
+// fixes no subset either. The ratio test does not see k (both norms scale alike). Off by default: on real receivers'
+// data under open sky the float often fails the test (a low-cost receiver's code is noisier than the model) while
+// its fixes agree with RTKLIB's, and the test would cost them (u-blox M8P, single frequency: 44 -> 15 fixed epochs);
+// config/fusion.yaml and config/rtk-urban.yaml turn it on (0.001), where reflections make the float lie.
+// A signal whose DD phase an innovation gate rejected is not fixed that epoch (as one the post-fit test rejected):
+// its ambiguity is the prior's, not this epoch's.
 // Modes: continuous, instantaneous (ambiguities re-initialised every epoch), fix-and-hold (the fixed DD ambiguities
 // fed back as pseudo-measurements with a small variance). When the whole set is not accepted, partial fixing
 // (partial_ar): the paper's pruning, dropping the satellite whose ambiguities contribute most to the integer
@@ -122,6 +134,7 @@ struct RtkOptions {
   bool partial_ar = true;                     ///< when the full set fails, fix a subset (pruning, groups)
   int max_pruned_satellites = 6;              ///< partial fixing drops at most this many satellites one by one
   double min_success_rate = 0.99;             ///< bootstrapped success rate a fix needs besides the ratio test
+  double float_consistency_level = 0.0;       ///< significance of the float consistency test (above); 0: no test
   double min_partial_fraction = 0.2;          ///< a partial fix keeps at least this fraction of the ambiguities
   double max_partial_fix_sigma_m = 0.05;      ///< a partial fix by the success rate must leave the position this
                                               ///< precise (3D sigma, m) to count as fixed
@@ -182,6 +195,9 @@ struct RtkEpoch {
                                              ///< threshold (max_post_fit_sigmas or _code_sigmas) after rejections
   std::vector<core::SatelliteId> ar_pruned;  ///< satellites partial fixing pruned by their ILS residual
   bool too_few_to_fix = false;  ///< the fixable ambiguities came from fewer than 4 satellites: no fix was tried
+  /// The float consistency test's variance factor k (1: consistent, or not tested this epoch; > 1: the float fits no
+  /// integer vector and the success rates were computed with Q_a scaled by k).
+  double float_variance_factor = 1.0;
   // Aided epochs: the prior (after the time update with the aiding).
   bool aided = false;
   Eigen::Vector3d prior_p_E_m = Eigen::Vector3d::Zero();
@@ -315,6 +331,11 @@ class RtkEngine {
   /// it leaves has a 3D sigma above max_partial_fix_sigma_m (then it is no fix, but the float position conditioned on
   /// it is still the better float).
   [[nodiscard]] std::optional<Fix> success_rate_subset_fix(const Fix& full, int min_size) const;
+  /// The float consistency test on the full set's search (see above), made with float_variance_factor_ at 1: sets
+  /// it when the test fails, and rescales the set's success rate.
+  void test_float_consistency(Fix& full);
+  /// Bootstrapped success rate of conditional variances `d` scaled by float_variance_factor_.
+  [[nodiscard]] double success_rate(const Eigen::VectorXd& d) const;
   /// Ratio test, success rate and agreement with the last fix (and the aiding's accept_fix when aided).
   [[nodiscard]] bool accepted(const Fix& fix) const;
   /// Why a fix is not accepted, with its figures (for --verbose).
@@ -402,9 +423,11 @@ class RtkEngine {
     std::int64_t last_epoch = 0;  // ar_epoch_ of its last search
   };
   mutable std::map<std::vector<DdKey>, CarriedDecorrelation> carried_decorrelations_;
-  std::int64_t ar_epoch_ = 0;      // epochs through resolve_ambiguities
-  int epochs_since_full_set_ = 0;  // epochs since the full set was last searched
-  bool iono_estimated_ = false;    // ionosphere states in use at this epoch
+  std::int64_t ar_epoch_ = 0;           // epochs through resolve_ambiguities
+  int epochs_since_full_set_ = 0;       // epochs since the full set was last searched
+  double float_variance_factor_ = 1.0;  // of the full set's last search (test_float_consistency)
+  double consistency_z_ = 0.0;          // normal quantile of float_consistency_level (0: no test)
+  bool iono_estimated_ = false;         // ionosphere states in use at this epoch
 };
 
 [[nodiscard]] const char* ar_mode_name(ArMode mode);

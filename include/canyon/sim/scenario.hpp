@@ -98,7 +98,10 @@ struct ReceiverOptions {
 
 /// Reflections at the rover (multipath and NLOS). The base is an open-sky geodetic installation without multipath.
 struct ReflectionOptions {
-  bool multipath = true;              ///< line-of-sight signals also get reflections off walls and the ground
+  bool multipath = true;  ///< line-of-sight signals also get reflections off walls and the ground
+  /// A signal whose direct path a building blocks is received by a wall reflection (NLOS) when one exists; false: not
+  /// at all, as by an ideal antenna and receiver that reject every reflection (the bound of perfect NLOS exclusion).
+  bool nlos = true;
   double wall_loss_db = 10.0;         ///< power of a wall reflection below the direct signal (dB)
   double nlos_extra_loss_db = 2.0;    ///< extra loss of a reflection received without the direct signal (dB)
   double ground_loss_db = 35.0;       ///< power of the ground reflection below the direct signal (dB)
