@@ -224,6 +224,7 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("cn0_quantile", o.cn0.quantile);
   map.get("cn0_bin_deg", o.cn0.bin_deg);
   map.get("cn0_min_samples", o.cn0.min_samples);
+  map.get("cn0_monotone", o.cn0.monotone);
   map.reject_unknown_keys();
 }
 
@@ -490,6 +491,7 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("cn0_quantile") << o.cn0.quantile;
   key("cn0_bin_deg") << o.cn0.bin_deg;
   key("cn0_min_samples") << o.cn0.min_samples;
+  key("cn0_monotone") << o.cn0.monotone;
   out << YAML::EndMap;
 }
 

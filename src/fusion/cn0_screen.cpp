@@ -30,6 +30,7 @@ std::string Cn0ScreenOptions::validate() const {
 
 Cn0Screen::Cn0Screen(Cn0ScreenOptions options) : options_(options) {
   histograms_.resize(static_cast<std::size_t>(core::kNumConstellations) * kBands * kMaxElevationBins);
+  levels_.assign(histograms_.size(), -1.0);
 }
 
 int Cn0Screen::key(core::Constellation system, char band, double elevation_rad) const {
@@ -40,7 +41,16 @@ int Cn0Screen::key(core::Constellation system, char band, double elevation_rad) 
 }
 
 double Cn0Screen::level_dbhz(core::Constellation system, char band, double elevation_rad) const {
-  const Histogram& h = histograms_[static_cast<std::size_t>(key(system, band, elevation_rad))];
+  const int k = key(system, band, elevation_rad);
+  if (!options_.monotone) return levels_[static_cast<std::size_t>(k)];
+  // The bins of one (system, band) are consecutive keys, lowest elevation first.
+  const int lowest = k - k % kMaxElevationBins;
+  double level = -1.0;
+  for (int i = lowest; i <= k; ++i) level = std::max(level, levels_[static_cast<std::size_t>(i)]);
+  return level;
+}
+
+double Cn0Screen::bin_level_dbhz(const Histogram& h) const {
   if (h.total < options_.min_samples) return -1.0;
   const double target = options_.quantile * h.total;
   int cumulative = 0;
@@ -92,10 +102,15 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
   }
   std::erase_if(epoch.sats, [](const core::SatelliteObs& s) { return s.signals.empty(); });
   for (const Seen& s : seen) {
-    Histogram& h = histograms_[static_cast<std::size_t>(key(s.system, s.band, s.elevation_rad))];
+    const auto k = static_cast<std::size_t>(key(s.system, s.band, s.elevation_rad));
+    Histogram& h = histograms_[k];
     const int bin = std::clamp(static_cast<int>(s.snr_dbhz / kBinDb), 0, kHistogramBins - 1);
     ++h.counts[static_cast<std::size_t>(bin)];
     ++h.total;
+  }
+  for (const Seen& s : seen) {  // the levels of the bins that learnt (a bin seen twice is computed twice)
+    const auto k = static_cast<std::size_t>(key(s.system, s.band, s.elevation_rad));
+    levels_[k] = bin_level_dbhz(histograms_[k]);
   }
   return removed;
 }

@@ -504,6 +504,51 @@ TEST(Cn0ScreenTest, RemovesTheNlosSignalsOfAStreetCanyonAndKeepsTheLineOfSightOn
               los_removed, los);
 }
 
+TEST(Cn0ScreenTest, TheMonotoneLevelCatchesTheReflectionsOfMiddleElevations) {
+  // In a deep canyon most signals of a middle elevation arrive by reflection, and the quantile of their own bin learns
+  // the NLOS level; the antenna's gain does not fall with elevation, so a bin's level is at least those below it.
+  sim::SimulationOptions options;
+  options.keep_signal_truth = true;
+  auto simulated = simulate_urban_severe(600.0, "cn0-monotone", options);
+  ASSERT_TRUE(simulated);
+  const sim::Simulation* sim = &simulated->sim;
+  const gnss::EphemerisStore eph(sim->nav);
+  struct Tally {
+    int nlos = 0, nlos_removed = 0, los = 0, los_removed = 0;
+  };
+  const auto screen_all = [&](bool monotone) {
+    Cn0ScreenOptions screen_options;
+    screen_options.monotone = monotone;
+    Cn0Screen screen(screen_options);
+    Tally tally;
+    for (std::size_t k = 0; k < sim->rover.epochs.size(); ++k) {
+      core::ObsEpoch e = sim->rover.epochs[k];
+      (void)screen.apply(e, eph, sim->truth[k].p_E_m);
+      if (k < sim->rover.epochs.size() / 10) continue;  // learning
+      for (const sim::SignalTruth& t : sim->rover.truth[k].signals) {
+        if (t.elevation_rad < 30.0 * core::kDegToRad || t.elevation_rad > 45.0 * core::kDegToRad) continue;
+        bool kept = false;
+        for (const core::SatelliteObs& sat : e.sats) {
+          if (sat.sat == t.sat && sat.find(t.code) != nullptr) kept = true;
+        }
+        (t.direct ? tally.los : tally.nlos) += 1;
+        (t.direct ? tally.los_removed : tally.nlos_removed) += kept ? 0 : 1;
+      }
+    }
+    return tally;
+  };
+  const Tally monotone = screen_all(true);
+  const Tally own_bins = screen_all(false);
+  std::printf(
+      "C/N0 screen, urban-severe 60-600 s, 30-45 deg: %d of %d NLOS signals removed with the monotone "
+      "level, %d with each bin's own; line of sight removed: %d and %d of %d\n",
+      monotone.nlos_removed, monotone.nlos, own_bins.nlos_removed, monotone.los_removed, own_bins.los_removed,
+      monotone.los);
+  ASSERT_GT(monotone.nlos, 1000);
+  EXPECT_GT(monotone.nlos_removed, own_bins.nlos_removed + monotone.nlos / 10);
+  EXPECT_LT(monotone.los_removed, monotone.los / 200);
+}
+
 // --- Epoch geometry built ahead -------------------------------------------------------------------------------------
 
 TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
