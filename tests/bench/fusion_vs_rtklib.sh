@@ -9,7 +9,8 @@
 #  2. Ablations of the fusion on the same files: without VIO covariance propagation (constant 5 cm per axis per epoch),
 #     without pruning (no innovation gate, no ILS pruning), without lever-arm calibration, the constant-velocity model
 #     instead of VIO; and the gates alone (paper, chi-square), without the false-fix guard, without the C/N0 screen,
-#     without the heading error state, without the integrity check, without the heading-free fill-in.
+#     without the heading error state, without the integrity check, without the heading-free fill-in, without the RTK
+#     engine's float consistency test, the C/N0 screen with each elevation bin's own level (not monotone).
 #  3. instinct-spirent-rtk-sim (real receiver-simulator GNSS files, 1 Hz, truth with attitude) with VIO from its truth
 #     (`canyon simulate --vio-from-truth`), the 5 and then 10 most observed satellites excluded, GPS+Galileo for canyon
 #     (RTKLIB 2.4.3 reads no Galileo record of these navigation files: GPS only), and GPS only for all three (also 4
@@ -66,6 +67,8 @@ variant no-cn0-screen "cn0_screen=false"
 variant no-heading "heading_state=false"
 variant no-integrity "integrity_check=false"
 variant no-heading-free "heading_free_fill_in=false"
+variant no-consistency "" "float_consistency_level=0"
+variant cn0-own-bins "cn0_monotone=false"
 
 now() { date +%s.%N; }
 elapsed() { awk -v s="$1" -v e="$2" 'BEGIN {printf "%.2f", e - s}'; }
@@ -161,7 +164,7 @@ if [[ ${ABLATIONS:-1} != 0 ]]; then
   echo
   echo "== 2. Ablations of canyon fusion (fix rate, availability, wrong fixes, 3D RMSE; same files as above)"
   names=(full no-covariance no-pruning no-calibration constant-velocity gate-paper gate-chi-square no-guard no-cn0-screen
-    no-heading no-integrity no-heading-free)
+    no-heading no-integrity no-heading-free no-consistency cn0-own-bins)
   printf '%-14s %4s' scenario seed
   for name in "${names[@]}"; do printf ' | %-30s' "$name"; done
   echo
