@@ -225,6 +225,8 @@ void parse_fusion(YamlMap map, fusion::FusionOptions& o) {
   map.get("cn0_bin_deg", o.cn0.bin_deg);
   map.get("cn0_min_samples", o.cn0.min_samples);
   map.get("cn0_monotone", o.cn0.monotone);
+  map.get("cn0_cross_system", o.cn0.cross_system);
+  map.get("cn0_cross_system_db", o.cn0.cross_system_db);
   map.reject_unknown_keys();
 }
 
@@ -492,6 +494,8 @@ static void emit_fusion(YAML::Emitter& out, const fusion::FusionOptions& o) {
   key("cn0_bin_deg") << o.cn0.bin_deg;
   key("cn0_min_samples") << o.cn0.min_samples;
   key("cn0_monotone") << o.cn0.monotone;
+  key("cn0_cross_system") << o.cn0.cross_system;
+  key("cn0_cross_system_db") << o.cn0.cross_system_db;
   out << YAML::EndMap;
 }
 

@@ -22,32 +22,68 @@ int band_index(char band) {
 
 std::string Cn0ScreenOptions::validate() const {
   if (!(margin_db > 0.0)) return "cn0_margin_db must be > 0";
+  if (!(cross_system_db >= 0.0)) return "cn0_cross_system_db must be >= 0";
   if (!(quantile > 0.0 && quantile < 1.0)) return "cn0_quantile must be in (0, 1)";
   if (!(bin_deg >= 1.0 && bin_deg <= 90.0)) return "cn0_bin_deg must be in [1, 90]";
   if (min_samples < 1) return "cn0_min_samples must be >= 1";
   return {};
 }
 
-Cn0Screen::Cn0Screen(Cn0ScreenOptions options) : options_(options) {
-  histograms_.resize(static_cast<std::size_t>(core::kNumConstellations) * kBands * kMaxElevationBins);
+Cn0Screen::Cn0Screen(Cn0ScreenOptions options)
+    : options_(options),
+      elevation_bins_(std::min(kMaxElevationBins, static_cast<int>(std::ceil(90.0 / options_.bin_deg)))) {
+  constexpr int kSystemBands = core::kNumConstellations * kBands;
+  histograms_.resize(static_cast<std::size_t>(kSystemBands) * kMaxElevationBins);
   levels_.assign(histograms_.size(), -1.0);
+  bin_levels_.assign(histograms_.size(), -1.0);
+  band_group_.assign(kSystemBands, -1);
+  for (int s = 0; s < core::kNumConstellations; ++s) {
+    for (int b = 0; b < kBands; ++b) {
+      const auto f_hz = core::carrier_frequency_hz(static_cast<core::Constellation>(s),
+                                                   core::SignalCode{static_cast<char>('0' + b), 'C'}, 0);
+      if (f_hz) band_group_[static_cast<std::size_t>(s * kBands + b)] = *f_hz > 1.4e9 ? 0 : 1;
+    }
+  }
 }
 
 int Cn0Screen::key(core::Constellation system, char band, double elevation_rad) const {
-  const int bins = std::min(kMaxElevationBins, static_cast<int>(std::ceil(90.0 / options_.bin_deg)));
-  const int bin =
-      std::clamp(static_cast<int>(std::max(elevation_rad, 0.0) * core::kRadToDeg / options_.bin_deg), 0, bins - 1);
+  const int bin = std::clamp(static_cast<int>(std::max(elevation_rad, 0.0) * core::kRadToDeg / options_.bin_deg), 0,
+                             elevation_bins_ - 1);
   return (static_cast<int>(system) * kBands + band_index(band)) * kMaxElevationBins + bin;
 }
 
 double Cn0Screen::level_dbhz(core::Constellation system, char band, double elevation_rad) const {
-  const int k = key(system, band, elevation_rad);
-  if (!options_.monotone) return levels_[static_cast<std::size_t>(k)];
-  // The bins of one (system, band) are consecutive keys, lowest elevation first.
-  const int lowest = k - k % kMaxElevationBins;
-  double level = -1.0;
-  for (int i = lowest; i <= k; ++i) level = std::max(level, levels_[static_cast<std::size_t>(i)]);
-  return level;
+  return levels_[static_cast<std::size_t>(key(system, band, elevation_rad))];
+}
+
+void Cn0Screen::refresh_levels() {
+  // Each bin's own quantile, then (monotone) the running maximum from the lowest bin up, then (cross_system) the
+  // other constellations' levels of the same part of the L band, less cross_system_db.
+  std::vector<double> own(levels_.size(), -1.0);
+  for (const int sb : seen_bands_) {
+    double running = -1.0;
+    for (int bin = 0; bin < elevation_bins_; ++bin) {
+      const auto k = static_cast<std::size_t>(sb * kMaxElevationBins + bin);
+      const double level = bin_levels_[k];
+      running = std::max(running, level);
+      own[k] = options_.monotone ? running : level;
+    }
+  }
+  for (const int sb : seen_bands_) {
+    const int group = band_group_[static_cast<std::size_t>(sb)];
+    for (int bin = 0; bin < elevation_bins_; ++bin) {
+      const auto k = static_cast<std::size_t>(sb * kMaxElevationBins + bin);
+      double level = own[k];
+      if (options_.cross_system && group >= 0) {
+        for (const int other : seen_bands_) {
+          if (other / kBands == sb / kBands || band_group_[static_cast<std::size_t>(other)] != group) continue;
+          const double theirs = own[static_cast<std::size_t>(other * kMaxElevationBins + bin)];
+          if (theirs > 0.0) level = std::max(level, theirs - options_.cross_system_db);
+        }
+      }
+      levels_[k] = level;
+    }
+  }
 }
 
 double Cn0Screen::bin_level_dbhz(const Histogram& h) const {
@@ -102,16 +138,19 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
   }
   std::erase_if(epoch.sats, [](const core::SatelliteObs& s) { return s.signals.empty(); });
   for (const Seen& s : seen) {
-    const auto k = static_cast<std::size_t>(key(s.system, s.band, s.elevation_rad));
-    Histogram& h = histograms_[k];
+    const int k = key(s.system, s.band, s.elevation_rad);
+    Histogram& h = histograms_[static_cast<std::size_t>(k)];
     const int bin = std::clamp(static_cast<int>(s.snr_dbhz / kBinDb), 0, kHistogramBins - 1);
     ++h.counts[static_cast<std::size_t>(bin)];
     ++h.total;
+    const int sb = k / kMaxElevationBins;
+    if (std::find(seen_bands_.begin(), seen_bands_.end(), sb) == seen_bands_.end()) seen_bands_.push_back(sb);
   }
-  for (const Seen& s : seen) {  // the levels of the bins that learnt (a bin seen twice is computed twice)
+  for (const Seen& s : seen) {  // the quantiles of the bins that learnt (a bin seen twice is computed twice)
     const auto k = static_cast<std::size_t>(key(s.system, s.band, s.elevation_rad));
-    levels_[k] = bin_level_dbhz(histograms_[k]);
+    bin_levels_[k] = bin_level_dbhz(histograms_[k]);
   }
+  if (!seen.empty()) refresh_levels();
   return removed;
 }
 

@@ -504,41 +504,44 @@ TEST(Cn0ScreenTest, RemovesTheNlosSignalsOfAStreetCanyonAndKeepsTheLineOfSightOn
               los_removed, los);
 }
 
+/// NLOS and line-of-sight signals of urban-severe (seed 1, 600 s) between `min_deg` and `max_deg` of elevation after
+/// the first minute, and how many of each a screen with `options` removed (the truth's antenna positions).
+struct ScreenTally {
+  int nlos = 0, nlos_removed = 0, los = 0, los_removed = 0;
+};
+ScreenTally screen_urban_severe(const sim::Simulation& sim, const Cn0ScreenOptions& options, double min_deg,
+                                double max_deg) {
+  const gnss::EphemerisStore eph(sim.nav);
+  Cn0Screen screen(options);
+  ScreenTally tally;
+  for (std::size_t k = 0; k < sim.rover.epochs.size(); ++k) {
+    core::ObsEpoch e = sim.rover.epochs[k];
+    (void)screen.apply(e, eph, sim.truth[k].p_E_m);
+    if (k < sim.rover.epochs.size() / 10) continue;  // learning
+    for (const sim::SignalTruth& t : sim.rover.truth[k].signals) {
+      if (t.elevation_rad < min_deg * core::kDegToRad || t.elevation_rad > max_deg * core::kDegToRad) continue;
+      bool kept = false;
+      for (const core::SatelliteObs& sat : e.sats) {
+        if (sat.sat == t.sat && sat.find(t.code) != nullptr) kept = true;
+      }
+      (t.direct ? tally.los : tally.nlos) += 1;
+      (t.direct ? tally.los_removed : tally.nlos_removed) += kept ? 0 : 1;
+    }
+  }
+  return tally;
+}
+
 TEST(Cn0ScreenTest, TheMonotoneLevelCatchesTheReflectionsOfMiddleElevations) {
   // In a deep canyon most signals of a middle elevation arrive by reflection, and the quantile of their own bin learns
   // the NLOS level; the antenna's gain does not fall with elevation, so a bin's level is at least those below it.
-  sim::SimulationOptions options;
-  options.keep_signal_truth = true;
-  auto simulated = simulate_urban_severe(600.0, "cn0-monotone", options);
+  sim::SimulationOptions sim_options;
+  sim_options.keep_signal_truth = true;
+  auto simulated = simulate_urban_severe(600.0, "cn0-monotone", sim_options);
   ASSERT_TRUE(simulated);
-  const sim::Simulation* sim = &simulated->sim;
-  const gnss::EphemerisStore eph(sim->nav);
-  struct Tally {
-    int nlos = 0, nlos_removed = 0, los = 0, los_removed = 0;
-  };
-  const auto screen_all = [&](bool monotone) {
-    Cn0ScreenOptions screen_options;
-    screen_options.monotone = monotone;
-    Cn0Screen screen(screen_options);
-    Tally tally;
-    for (std::size_t k = 0; k < sim->rover.epochs.size(); ++k) {
-      core::ObsEpoch e = sim->rover.epochs[k];
-      (void)screen.apply(e, eph, sim->truth[k].p_E_m);
-      if (k < sim->rover.epochs.size() / 10) continue;  // learning
-      for (const sim::SignalTruth& t : sim->rover.truth[k].signals) {
-        if (t.elevation_rad < 30.0 * core::kDegToRad || t.elevation_rad > 45.0 * core::kDegToRad) continue;
-        bool kept = false;
-        for (const core::SatelliteObs& sat : e.sats) {
-          if (sat.sat == t.sat && sat.find(t.code) != nullptr) kept = true;
-        }
-        (t.direct ? tally.los : tally.nlos) += 1;
-        (t.direct ? tally.los_removed : tally.nlos_removed) += kept ? 0 : 1;
-      }
-    }
-    return tally;
-  };
-  const Tally monotone = screen_all(true);
-  const Tally own_bins = screen_all(false);
+  Cn0ScreenOptions own_bins_options;
+  own_bins_options.monotone = false;
+  const ScreenTally monotone = screen_urban_severe(simulated->sim, Cn0ScreenOptions{}, 30.0, 45.0);
+  const ScreenTally own_bins = screen_urban_severe(simulated->sim, own_bins_options, 30.0, 45.0);
   std::printf(
       "C/N0 screen, urban-severe 60-600 s, 30-45 deg: %d of %d NLOS signals removed with the monotone "
       "level, %d with each bin's own; line of sight removed: %d and %d of %d\n",
@@ -547,6 +550,27 @@ TEST(Cn0ScreenTest, TheMonotoneLevelCatchesTheReflectionsOfMiddleElevations) {
   ASSERT_GT(monotone.nlos, 1000);
   EXPECT_GT(monotone.nlos_removed, own_bins.nlos_removed + monotone.nlos / 10);
   EXPECT_LT(monotone.los_removed, monotone.los / 200);
+}
+
+TEST(Cn0ScreenTest, TheOtherConstellationsLevelCatchesTheReflectionsOfOneNeverSeenInLineOfSight) {
+  // GLONASS satellites that the canyon shows only by reflection at some elevations learn no line-of-sight level
+  // there; with cross_system the GPS and Galileo levels of the same part of the L band (less 3 dB) stand in.
+  sim::SimulationOptions sim_options;
+  sim_options.keep_signal_truth = true;
+  auto simulated = simulate_urban_severe(600.0, "cn0-cross", sim_options);
+  ASSERT_TRUE(simulated);
+  Cn0ScreenOptions cross;
+  cross.cross_system = true;
+  const ScreenTally with = screen_urban_severe(simulated->sim, cross, 15.0, 90.0);
+  const ScreenTally without = screen_urban_severe(simulated->sim, Cn0ScreenOptions{}, 15.0, 90.0);
+  std::printf(
+      "C/N0 screen, urban-severe 60-600 s, above 15 deg: %d of %d NLOS signals removed with the other "
+      "constellations' level, %d without; line of sight removed: %d and %d of %d\n",
+      with.nlos_removed, with.nlos, without.nlos_removed, with.los_removed, without.los_removed, with.los);
+  ASSERT_GT(with.nlos, 5000);
+  EXPECT_GT(with.nlos_removed, without.nlos_removed + with.nlos / 20);
+  EXPECT_GT(with.nlos_removed, 0.95 * with.nlos);
+  EXPECT_LT(with.los_removed, with.los / 200);
 }
 
 // --- Epoch geometry built ahead -------------------------------------------------------------------------------------
