@@ -68,7 +68,7 @@
 // variance factor k = norm / n, its a-posteriori estimate: a float that claims centimetres while it is decimetres off
 // fixes no subset either. The ratio test does not see k (both norms scale alike). Off by default: on real receivers'
 // data under open sky the float often fails the test (a low-cost receiver's code is noisier than the model) while
-// its fixes agree with RTKLIB's, and the test would cost them (u-blox M8P, single frequency: 44 -> 15 fixed epochs);
+// its fixes agree with RTKLIB's, and the test would cost them (u-blox M8P, single frequency: 44 -> 16 fixed epochs);
 // config/fusion.yaml and config/rtk-urban.yaml turn it on (0.001), where reflections make the float lie.
 // A signal whose DD phase an innovation gate rejected is not fixed that epoch (as one the post-fit test rejected):
 // its ambiguity is the prior's, not this epoch's.
