@@ -41,7 +41,8 @@ Cn0Screen::Cn0Screen(Cn0ScreenOptions options)
     for (int b = 0; b < kBands; ++b) {
       const auto f_hz = core::carrier_frequency_hz(static_cast<core::Constellation>(s),
                                                    core::SignalCode{static_cast<char>('0' + b), 'C'}, 0);
-      if (f_hz) band_group_[static_cast<std::size_t>(s * kBands + b)] = *f_hz > 1.4e9 ? 0 : 1;
+      const int sb = s * kBands + b;
+      if (f_hz) band_group_[static_cast<std::size_t>(sb)] = *f_hz > 1.4e9 ? 0 : 1;
     }
   }
 }
@@ -63,7 +64,8 @@ void Cn0Screen::refresh_levels() {
   for (const int sb : seen_bands_) {
     double running = -1.0;
     for (int bin = 0; bin < elevation_bins_; ++bin) {
-      const auto k = static_cast<std::size_t>(sb * kMaxElevationBins + bin);
+      const int index = sb * kMaxElevationBins + bin;
+      const auto k = static_cast<std::size_t>(index);
       const double level = bin_levels_[k];
       running = std::max(running, level);
       own[k] = options_.monotone ? running : level;
@@ -72,12 +74,14 @@ void Cn0Screen::refresh_levels() {
   for (const int sb : seen_bands_) {
     const int group = band_group_[static_cast<std::size_t>(sb)];
     for (int bin = 0; bin < elevation_bins_; ++bin) {
-      const auto k = static_cast<std::size_t>(sb * kMaxElevationBins + bin);
+      const int index = sb * kMaxElevationBins + bin;
+      const auto k = static_cast<std::size_t>(index);
       double level = own[k];
       if (options_.cross_system && group >= 0) {
         for (const int other : seen_bands_) {
           if (other / kBands == sb / kBands || band_group_[static_cast<std::size_t>(other)] != group) continue;
-          const double theirs = own[static_cast<std::size_t>(other * kMaxElevationBins + bin)];
+          const int their_index = other * kMaxElevationBins + bin;
+          const double theirs = own[static_cast<std::size_t>(their_index)];
           if (theirs > 0.0) level = std::max(level, theirs - options_.cross_system_db);
         }
       }
