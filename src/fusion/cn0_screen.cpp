@@ -36,6 +36,7 @@ Cn0Screen::Cn0Screen(Cn0ScreenOptions options)
   histograms_.resize(static_cast<std::size_t>(kSystemBands) * kMaxElevationBins);
   levels_.assign(histograms_.size(), -1.0);
   bin_levels_.assign(histograms_.size(), -1.0);
+  own_levels_.assign(histograms_.size(), -1.0);
   band_group_.assign(kSystemBands, -1);
   for (int s = 0; s < core::kNumConstellations; ++s) {
     for (int b = 0; b < kBands; ++b) {
@@ -60,7 +61,7 @@ double Cn0Screen::level_dbhz(core::Constellation system, char band, double eleva
 void Cn0Screen::refresh_levels() {
   // Each bin's own quantile, then (monotone) the running maximum from the lowest bin up, then (cross_system) the
   // other constellations' levels of the same part of the L band, less cross_system_db.
-  std::vector<double> own(levels_.size(), -1.0);
+  // own_levels_ is written and read for the seen (system, band) pairs only.
   for (const int sb : seen_bands_) {
     double running = -1.0;
     for (int bin = 0; bin < elevation_bins_; ++bin) {
@@ -68,7 +69,7 @@ void Cn0Screen::refresh_levels() {
       const auto k = static_cast<std::size_t>(index);
       const double level = bin_levels_[k];
       running = std::max(running, level);
-      own[k] = options_.monotone ? running : level;
+      own_levels_[k] = options_.monotone ? running : level;
     }
   }
   for (const int sb : seen_bands_) {
@@ -76,12 +77,12 @@ void Cn0Screen::refresh_levels() {
     for (int bin = 0; bin < elevation_bins_; ++bin) {
       const int index = sb * kMaxElevationBins + bin;
       const auto k = static_cast<std::size_t>(index);
-      double level = own[k];
+      double level = own_levels_[k];
       if (options_.cross_system && group >= 0) {
         for (const int other : seen_bands_) {
           if (other / kBands == sb / kBands || band_group_[static_cast<std::size_t>(other)] != group) continue;
           const int their_index = other * kMaxElevationBins + bin;
-          const double theirs = own[static_cast<std::size_t>(their_index)];
+          const double theirs = own_levels_[static_cast<std::size_t>(their_index)];
           if (theirs > 0.0) level = std::max(level, theirs - options_.cross_system_db);
         }
       }
@@ -147,12 +148,9 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
     const int bin = std::clamp(static_cast<int>(s.snr_dbhz / kBinDb), 0, kHistogramBins - 1);
     ++h.counts[static_cast<std::size_t>(bin)];
     ++h.total;
+    bin_levels_[static_cast<std::size_t>(k)] = bin_level_dbhz(h);  // a bin seen twice: the last one counts all
     const int sb = k / kMaxElevationBins;
     if (std::find(seen_bands_.begin(), seen_bands_.end(), sb) == seen_bands_.end()) seen_bands_.push_back(sb);
-  }
-  for (const Seen& s : seen) {  // the quantiles of the bins that learnt (a bin seen twice is computed twice)
-    const auto k = static_cast<std::size_t>(key(s.system, s.band, s.elevation_rad));
-    bin_levels_[k] = bin_level_dbhz(histograms_[k]);
   }
   if (!seen.empty()) refresh_levels();
   return removed;

@@ -918,17 +918,17 @@ std::vector<RtkEngine::DdKey> RtkEngine::dd_keys(const std::vector<std::pair<int
 }
 
 std::string RtkEngine::rejection_reason(const Fix& fix) const {
-  char numbers[160];
+  char figures[96];
+  std::snprintf(figures, sizeof figures, " (%d ambiguities, ratio %.1f, success rate %.3f",
+                static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate);
+  std::string numbers = figures;
   if (float_variance_factor_ > 1.0) {
-    std::snprintf(
-        numbers, sizeof numbers,
-        " (%d ambiguities, ratio %.1f, success rate %.3f with the float covariance scaled by %.1f: no integer "
-        "vector fits the float)",
-        static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate, float_variance_factor_);
-  } else {
-    std::snprintf(numbers, sizeof numbers, " (%d ambiguities, ratio %.1f, success rate %.3f)",
-                  static_cast<int>(fix.a_fix.size()), fix.ratio, fix.success_rate);
+    std::snprintf(figures, sizeof figures,
+                  " with the float covariance scaled by %.1f: no integer vector fits the float",
+                  float_variance_factor_);
+    numbers += figures;
   }
+  numbers += ")";
   if (fix.ratio < options_.ratio_threshold) return std::string("ratio test failed") + numbers;
   if (fix.success_rate < options_.min_success_rate) return std::string("success rate too low") + numbers;
   if (!agrees_with_last_fix(fix)) return std::string("contradicts the last fix") + numbers;

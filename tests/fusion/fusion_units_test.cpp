@@ -473,6 +473,13 @@ std::optional<Simulated> simulate_urban_severe(double duration_s, const std::str
   return simulate_scenario("urban-severe", duration_s, tag, options, seed);
 }
 
+/// The index of the base epoch to use with a rover epoch at `t`: the last within 0.05 s after it, moving on from
+/// `base` (the epochs come in time order).
+std::size_t base_epoch_for(const sim::Simulation& sim, std::size_t base, const core::GpsTime& t) {
+  while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - t <= 0.05) ++base;
+  return base;
+}
+
 // --- C/N0 screen ----------------------------------------------------------------------------------------------------
 
 TEST(Cn0ScreenTest, RemovesTheNlosSignalsOfAStreetCanyonAndKeepsTheLineOfSightOnes) {
@@ -593,7 +600,7 @@ TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
   int aided = 0;
   int screened = 0;
   for (const core::ObsEpoch& e : sim->rover.epochs) {
-    while (base + 1 < sim->base.epochs.size() && sim->base.epochs[base + 1].time - e.time <= 0.05) ++base;
+    base = base_epoch_for(*sim, base, e.time);
     const core::ObsEpoch* b = &sim->base.epochs[base];
     auto expected = own.process(e, b);
     FusionGeometry geometry = builder.build(e, b);
@@ -642,7 +649,7 @@ FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
   double sum2 = 0.0;
   for (std::size_t k = 0; k < sim.rover.epochs.size(); ++k) {
     const core::ObsEpoch& e = sim.rover.epochs[k];
-    while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - e.time <= 0.05) ++base;
+    base = base_epoch_for(sim, base, e.time);
     auto out = engine.process(e, &sim.base.epochs[base]);
     if (!out || out->solution.status == core::SolutionStatus::None) continue;
     const double error2_m2 = (out->solution.p_E_m - sim.truth[k].p_E_m).squaredNorm();
@@ -657,23 +664,26 @@ FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
   run.stats = engine.stats();
   return run;
 }
-FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
-                     const std::function<void(FusionOptions&)>& change) {
-  return run_fusion(sim, start, [&change](app::ProcessConfig& config) { change(config.fusion); });
-}
 
 /// urban-severe (seed, duration) fused with config/fusion.yaml as it is and with one feature turned off.
 struct Comparison {
   FusionRun with;
   FusionRun without;
 };
-std::optional<Comparison> with_and_without(std::uint64_t seed, double duration_s, const std::string& tag,
-                                           const std::function<void(FusionOptions&)>& turn_off) {
-  auto simulated = simulate_urban_severe(duration_s, tag, {}, seed);
+/// The shipped `scenario` (seed, duration) fused with config/fusion.yaml as it is and changed by `turn_off`.
+std::optional<Comparison> with_and_without(const std::string& scenario, std::uint64_t seed, double duration_s,
+                                           const std::string& tag,
+                                           const std::function<void(app::ProcessConfig&)>& turn_off) {
+  auto simulated = simulate_scenario(scenario, duration_s, tag, {}, seed);
   if (!simulated) return std::nullopt;
   const core::GpsTime start = simulated->scenario.start;
-  return Comparison{run_fusion(simulated->sim, start, [](FusionOptions&) {}),
+  return Comparison{run_fusion(simulated->sim, start, [](app::ProcessConfig&) {}),
                     run_fusion(simulated->sim, start, turn_off)};
+}
+std::optional<Comparison> with_and_without(std::uint64_t seed, double duration_s, const std::string& tag,
+                                           const std::function<void(FusionOptions&)>& turn_off) {
+  return with_and_without("urban-severe", seed, duration_s, tag,
+                          [&turn_off](app::ProcessConfig& config) { turn_off(config.fusion); });
 }
 
 TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCanyon) {
@@ -729,17 +739,18 @@ TEST(FusionHeadingFreeTest, AStartInTheCanyonHasASolutionAtEveryEpoch) {
 
 // --- Float consistency (rtk::RtkOptions::float_consistency_level) ------------------------------------------------
 
+void no_consistency_test(app::ProcessConfig& config) {
+  config.rtk.float_consistency_level = 0.0;
+}
+
 TEST(FloatConsistencyTest, AFloatThatFitsNoIntegersFixesNothingInAMidRiseCanyon) {
   // urban-moderate, seed 7: walls 10 dB reflections beside the sidewalk give every line-of-sight code an error of
   // metres that holds for minutes, which the filter takes as white noise; its float claims centimetres while it is
   // decimetres off, its integer search finds no vector that fits (squared norms 10-20 times their number) and, with
   // the success rate of that claimed covariance, fix-and-hold held a wrong set for minutes (901 wrong fixes).
-  auto simulated = simulate_scenario("urban-moderate", 600.0, "consistency", {}, 7);
-  ASSERT_TRUE(simulated);
-  const core::GpsTime start = simulated->scenario.start;
-  const FusionRun with = run_fusion(simulated->sim, start, [](app::ProcessConfig&) {});
-  const FusionRun without =
-      run_fusion(simulated->sim, start, [](app::ProcessConfig& c) { c.rtk.float_consistency_level = 0.0; });
+  const auto runs = with_and_without("urban-moderate", 7, 600.0, "consistency", no_consistency_test);
+  ASSERT_TRUE(runs);
+  const auto& [with, without] = *runs;
   std::printf(
       "urban-moderate seed 7, 600 s: %d fixed, %d wrong with the float consistency test (%d epochs failed it); %d "
       "fixed, %d wrong without\n",
@@ -767,7 +778,7 @@ TEST(FloatConsistencyTest, CanyonRtkTakesNoWrongFixesInAMidRiseCanyon) {
     int wrong = 0;
     for (std::size_t k = 0; k < sim.rover.epochs.size(); ++k) {
       const core::ObsEpoch& e = sim.rover.epochs[k];
-      while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - e.time <= 0.05) ++base;
+      base = base_epoch_for(sim, base, e.time);
       auto out = engine.process(e, &sim.base.epochs[base]);
       if (!out) continue;
       if (out->float_variance_factor > 1.0) ++inconsistent;
@@ -792,12 +803,9 @@ TEST(FloatConsistencyTest, CanyonRtkTakesNoWrongFixesInAMidRiseCanyon) {
 
 TEST(FloatConsistencyTest, OpenSkyFixesAreUnchanged) {
   // Where the model holds, the test never fires: the same solutions, epoch for epoch.
-  auto simulated = simulate_scenario("light-blocked", 300.0, "consistency-open", {}, 1);
-  ASSERT_TRUE(simulated);
-  const core::GpsTime start = simulated->scenario.start;
-  const FusionRun with = run_fusion(simulated->sim, start, [](app::ProcessConfig&) {});
-  const FusionRun without =
-      run_fusion(simulated->sim, start, [](app::ProcessConfig& c) { c.rtk.float_consistency_level = 0.0; });
+  const auto runs = with_and_without("light-blocked", 1, 300.0, "consistency-open", no_consistency_test);
+  ASSERT_TRUE(runs);
+  const auto& [with, without] = *runs;
   EXPECT_EQ(with.fixed, without.fixed);
   EXPECT_DOUBLE_EQ(with.rmse_m, without.rmse_m);
   EXPECT_GT(with.fixed, 0.9 * with.stats.epochs);

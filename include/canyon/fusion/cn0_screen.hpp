@@ -81,6 +81,7 @@ class Cn0Screen {
   std::vector<int> band_group_;     // per (system, band): 0 upper L band, 1 lower, -1 unknown
   std::vector<int> seen_bands_;     // the (system, band) indices seen so far
   std::vector<double> bin_levels_;  // bin_level_dbhz of each histogram, refreshed when it learns
+  std::vector<double> own_levels_;  // refresh_levels()'s scratch: a bin's level from its own (system, band)
   std::vector<double> levels_;      // the screening level of each histogram's bin (negative: none)
 };
 
