@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Issue 5's urban-severe targets over many seeds: for each seed, canyon simulate, RTKLIB 2.4.3 (rnx2rtkp -k
 # config/rtklib/sim.conf) and canyon fusion (config/fusion.yaml or CONFIG), both scored by canyon evaluate; one line per
-# seed (3D RMSE, availability, RTKLIB's, whether fusion's RMSE <= 1/5 of RTKLIB's) and a tally: seeds with a solution
-# at every epoch, seeds meeting the RMSE ratio, median RMSE.
+# seed (3D RMSE, availability, fixed epochs and wrong fixes, RTKLIB's RMSE and availability, whether fusion's RMSE <=
+# 1/5 of RTKLIB's) and a tally: seeds with a solution at every epoch, seeds meeting the RMSE ratio, median RMSE, fixed
+# epochs and wrong fixes (3D error > 0.10 m).
 # Usage: tests/bench/fusion_seeds.sh [BUILD_DIR] [FIRST] [LAST] [SCENARIO] [CONFIG]
 #   defaults: build, 1, 30, urban-severe, config/fusion.yaml. KEEP=1 keeps the temp folder and prints its path.
 # Exit status: 0 done, 2 missing build or tools.
@@ -52,18 +53,23 @@ def figures(label):
     return s["ape"]["all"]["3d"]["rmse_m"], s["availability"]
 f, fa = figures("fusion")
 r, ra = figures("RTKLIB")
+fusion = solutions.get("fusion", {})
+fixed, wrong = fusion.get("status", {}).get("fixed", {}).get("epochs", 0), fusion.get("wrong_fixes", 0)
 every, ratio = fa >= 1.0 - 1e-9, f <= r / 5
-print("seed %3s: fusion %8.2f m, %6.2f %% | RTKLIB %8.2f m, %6.2f %% | every epoch: %-3s | RMSE <= 1/5 RTKLIB: %s"
-      % (seed, f, 100 * fa, r, 100 * ra, "yes" if every else "no", "yes" if ratio else "no"))
+print("seed %3s: fusion %8.2f m, %6.2f %%, fixed %5d, wrong %5d | RTKLIB %8.2f m, %6.2f %% | every epoch: %-3s | "
+      "RMSE <= 1/5 RTKLIB: %s" % (seed, f, 100 * fa, fixed, wrong, r, 100 * ra, "yes" if every else "no",
+                                  "yes" if ratio else "no"))
 with open(table, "a") as out:
-    out.write("%s\t%r\t%d\t%d\n" % (seed, f, every, ratio))
+    out.write("%s\t%r\t%d\t%d\t%d\t%d\n" % (seed, f, every, ratio, fixed, wrong))
 PY
 done
 python3 - "$tmp/seeds.tsv" <<'PY'
 import math, statistics, sys
 rows = [line.split("\t") for line in open(sys.argv[1])]
 rmse = [float(r[1]) for r in rows if not math.isnan(float(r[1]))]
-print("%d seeds: a solution at every epoch on %d, RMSE <= 1/5 of RTKLIB's on %d, median fusion RMSE %.1f m"
+fixed, wrong = sum(int(r[4]) for r in rows), sum(int(r[5]) for r in rows)
+print("%d seeds: a solution at every epoch on %d, RMSE <= 1/5 of RTKLIB's on %d, median fusion RMSE %.1f m; "
+      "fusion fixed %d epochs, %d of them wrong (3D error > 0.10 m)"
       % (len(rows), sum(int(r[2]) for r in rows), sum(int(r[3]) for r in rows),
-         statistics.median(rmse) if rmse else float("nan")))
+         statistics.median(rmse) if rmse else float("nan"), fixed, wrong))
 PY
