@@ -112,13 +112,7 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
   if (!options_.enabled) return 0;
   const core::Geodetic g = core::ecef_to_geodetic(p_E_approx_m);
   const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
-  struct Seen {
-    core::Constellation system;
-    char band;
-    double elevation_rad;
-    double snr_dbhz;
-  };
-  std::vector<Seen> seen;
+  learnt_.clear();
   int removed = 0;
   for (core::SatelliteObs& sat : epoch.sats) {
     double pseudorange_m = core::kNoValue;
@@ -135,15 +129,16 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
     const auto before = sat.signals.size();
     std::erase_if(sat.signals, [&](const core::SignalObs& s) {
       if (!core::has_value(s.snr_dbhz)) return false;
-      seen.push_back(Seen{sat.sat.system, s.code.band, elevation, s.snr_dbhz});
-      const double level = level_dbhz(sat.sat.system, s.code.band, elevation);
+      const int k = key(sat.sat.system, s.code.band, elevation);
+      learnt_.push_back(Learnt{k, s.snr_dbhz});
+      const double level = levels_[static_cast<std::size_t>(k)];
       return level > 0.0 && s.snr_dbhz < level - options_.margin_db;
     });
     removed += static_cast<int>(before - sat.signals.size());
   }
   std::erase_if(epoch.sats, [](const core::SatelliteObs& s) { return s.signals.empty(); });
-  for (const Seen& s : seen) {
-    const int k = key(s.system, s.band, s.elevation_rad);
+  for (const Learnt& s : learnt_) {
+    const int k = s.key;
     Histogram& h = histograms_[static_cast<std::size_t>(k)];
     const int bin = std::clamp(static_cast<int>(s.snr_dbhz / kBinDb), 0, kHistogramBins - 1);
     ++h.counts[static_cast<std::size_t>(bin)];
@@ -152,7 +147,7 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
     const int sb = k / kMaxElevationBins;
     if (std::find(seen_bands_.begin(), seen_bands_.end(), sb) == seen_bands_.end()) seen_bands_.push_back(sb);
   }
-  if (!seen.empty()) refresh_levels();
+  if (!learnt_.empty()) refresh_levels();
   return removed;
 }
 

@@ -83,6 +83,11 @@ class Cn0Screen {
   std::vector<double> bin_levels_;  // bin_level_dbhz of each histogram, refreshed when it learns
   std::vector<double> own_levels_;  // refresh_levels()'s scratch: a bin's level from its own (system, band)
   std::vector<double> levels_;      // the screening level of each histogram's bin (negative: none)
+  struct Learnt {
+    int key;  // the histogram of the signal's (system, band, elevation bin)
+    double snr_dbhz;
+  };
+  std::vector<Learnt> learnt_;  // apply()'s scratch: the epoch's signals to learn from (kept: no allocation per epoch)
 };
 
 }  // namespace canyon::fusion
