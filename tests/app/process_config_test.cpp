@@ -47,6 +47,8 @@ TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {
   expected_fusion.rtk.ar_mode = rtk::ArMode::FixAndHold;
   expected_fusion.rtk.ionosphere = rtk::IonosphereModel::Estimate;
   expected_fusion.rtk.float_consistency_level = 0.001;
+  expected_fusion.rtk.snr_weighting = true;
+  expected_fusion.rtk.ambiguity_noise_cyc = 0.01;
   EXPECT_EQ(to_yaml(*fusion), to_yaml(expected_fusion));
 }
 

@@ -704,13 +704,13 @@ TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCa
 }
 
 TEST(FusionIntegrityTest, AnOutputThatLeftTheSinglePointsStartsAgainFromThem) {
-  // urban-severe, seed 4: the first alignment is made to solutions tens of metres off and the VIO carries the
-  // position along, 90 m from the single points after 90 s of the 600. The integrity check moves it to them (and
+  // urban-severe, seed 22: the VIO carries an output that an alignment to biased solutions put off the street away
+  // from the single points (380 m RMSE over the 600 s without the check). The integrity check moves it to them (and
   // restarts the ambiguities and the heading); without it the error stays.
-  const auto runs = with_and_without(4, 600.0, "integrity", [](FusionOptions& o) { o.integrity_check = false; });
+  const auto runs = with_and_without(22, 600.0, "integrity", [](FusionOptions& o) { o.integrity_check = false; });
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
-  std::printf("urban-severe seed 4, 600 s: 3D RMSE %.1f m with the integrity check (%d restarts), %.1f m without\n",
+  std::printf("urban-severe seed 22, 600 s: 3D RMSE %.1f m with the integrity check (%d restarts), %.1f m without\n",
               with.rmse_m, with.stats.integrity_restarts, without.rmse_m);
   EXPECT_GE(with.stats.integrity_restarts, 1);
   EXPECT_EQ(without.stats.integrity_restarts, 0);
@@ -744,18 +744,19 @@ void no_consistency_test(app::ProcessConfig& config) {
 }
 
 TEST(FloatConsistencyTest, AFloatThatFitsNoIntegersFixesNothingInAMidRiseCanyon) {
-  // urban-moderate, seed 7: walls 10 dB reflections beside the sidewalk give every line-of-sight code an error of
+  // urban-moderate, seed 9: walls 10 dB reflections beside the sidewalk give every line-of-sight code an error of
   // metres that holds for minutes, which the filter takes as white noise; its float claims centimetres while it is
-  // decimetres off, its integer search finds no vector that fits (squared norms 10-20 times their number) and, with
-  // the success rate of that claimed covariance, fix-and-hold held a wrong set for minutes (901 wrong fixes).
-  const auto runs = with_and_without("urban-moderate", 7, 600.0, "consistency", no_consistency_test);
+  // decimetres off, its integer search finds no vector that fits and, with the success rate of that claimed
+  // covariance, fix-and-hold held a wrong set (121 wrong fixes, even with the ambiguity random walk that bounds what
+  // the float learns from the code).
+  const auto runs = with_and_without("urban-moderate", 9, 600.0, "consistency", no_consistency_test);
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
   std::printf(
-      "urban-moderate seed 7, 600 s: %d fixed, %d wrong with the float consistency test (%d epochs failed it); %d "
+      "urban-moderate seed 9, 600 s: %d fixed, %d wrong with the float consistency test (%d epochs failed it); %d "
       "fixed, %d wrong without\n",
       with.fixed, with.wrong_fixes, with.stats.float_inconsistent, without.fixed, without.wrong_fixes);
-  EXPECT_GT(without.wrong_fixes, 100) << "the scenario no longer shows what the test is for";
+  EXPECT_GT(without.wrong_fixes, 50) << "the scenario no longer shows what the test is for";
   EXPECT_LE(with.wrong_fixes, 0.01 * with.fixed);
   EXPECT_GT(with.stats.float_inconsistent, 0);
   EXPECT_EQ(without.stats.float_inconsistent, 0);
