@@ -704,9 +704,9 @@ TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCa
 }
 
 TEST(FusionIntegrityTest, AnOutputThatLeftTheSinglePointsStartsAgainFromThem) {
-  // urban-severe, seed 22: the VIO carries an output that an alignment to biased solutions put off the street away
-  // from the single points (380 m RMSE over the 600 s without the check). The integrity check moves it to them (and
-  // restarts the ambiguities and the heading); without it the error stays.
+  // urban-severe, seed 22: without the check the VIO carries the output hundreds of metres away from the single points
+  // (380 m RMSE over the 600 s). The integrity check moves it back to them (twice; it restarts the ambiguities and the
+  // heading too); without it the error stays.
   const auto runs = with_and_without(22, 600.0, "integrity", [](FusionOptions& o) { o.integrity_check = false; });
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
