@@ -54,10 +54,6 @@ int Cn0Screen::key(core::Constellation system, char band, double elevation_rad) 
   return (static_cast<int>(system) * kBands + band_index(band)) * kMaxElevationBins + bin;
 }
 
-double Cn0Screen::level_dbhz(core::Constellation system, char band, double elevation_rad) const {
-  return levels_[static_cast<std::size_t>(key(system, band, elevation_rad))];
-}
-
 void Cn0Screen::refresh_levels() {
   // Each bin's own quantile, then (monotone) the running maximum from the lowest bin up, then (cross_system) the
   // other constellations' levels of the same part of the L band, less cross_system_db.
@@ -137,15 +133,19 @@ int Cn0Screen::apply(core::ObsEpoch& epoch, gnss::EpochSatelliteStates& states, 
     removed += static_cast<int>(before - sat.signals.size());
   }
   std::erase_if(epoch.sats, [](const core::SatelliteObs& s) { return s.signals.empty(); });
-  for (const Learnt& s : learnt_) {
-    const int k = s.key;
+  touched_.clear();
+  for (const auto& [k, snr_dbhz] : learnt_) {
     Histogram& h = histograms_[static_cast<std::size_t>(k)];
-    const int bin = std::clamp(static_cast<int>(s.snr_dbhz / kBinDb), 0, kHistogramBins - 1);
+    const int bin = std::clamp(static_cast<int>(snr_dbhz / kBinDb), 0, kHistogramBins - 1);
     ++h.counts[static_cast<std::size_t>(bin)];
     ++h.total;
-    bin_levels_[static_cast<std::size_t>(k)] = bin_level_dbhz(h);  // a bin seen twice: the last one counts all
+    if (std::find(touched_.begin(), touched_.end(), k) == touched_.end()) touched_.push_back(k);
     const int sb = k / kMaxElevationBins;
     if (std::find(seen_bands_.begin(), seen_bands_.end(), sb) == seen_bands_.end()) seen_bands_.push_back(sb);
+  }
+  // Each histogram's quantile once, after all of the epoch's signals are counted.
+  for (const int k : touched_) {
+    bin_levels_[static_cast<std::size_t>(k)] = bin_level_dbhz(histograms_[static_cast<std::size_t>(k)]);
   }
   if (!learnt_.empty()) refresh_levels();
   return removed;

@@ -815,7 +815,7 @@ TEST(FloatConsistencyTest, OpenSkyFixesAreUnchanged) {
 // --- Ambiguity random walk (config/fusion.yaml: rtk.ambiguity_noise_cyc 0.01) -------------------------------------
 
 void ambiguity_walk_of_rtk_yaml(app::ProcessConfig& config) {
-  config.rtk.ambiguity_noise_cyc = 1e-4;
+  config.rtk.ambiguity_noise_cyc = rtk::RtkOptions{}.ambiguity_noise_cyc;  // rtk.yaml's value: the default
 }
 
 TEST(AmbiguityWalkTest, BiasedFloatsOfAMidRiseStreetFixNothingWrong) {

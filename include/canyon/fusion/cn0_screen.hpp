@@ -59,8 +59,6 @@ class Cn0Screen {
 
   /// Whether the screen removes anything (Cn0ScreenOptions::enabled).
   [[nodiscard]] bool enabled() const { return options_.enabled; }
-  /// The learnt line-of-sight level (dB-Hz) of a bin, or a negative value if it has too few samples.
-  [[nodiscard]] double level_dbhz(core::Constellation system, char band, double elevation_rad) const;
 
  private:
   static constexpr int kHistogramBins = 140;    // 0.5 dB from 0 to 70 dB-Hz
@@ -88,6 +86,7 @@ class Cn0Screen {
     double snr_dbhz;
   };
   std::vector<Learnt> learnt_;  // apply()'s scratch: the epoch's signals to learn from (kept: no allocation per epoch)
+  std::vector<int> touched_;    // apply()'s scratch: the histograms those signals went to, each once
 };
 
 }  // namespace canyon::fusion
