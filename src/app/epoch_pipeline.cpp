@@ -2,6 +2,7 @@
 
 #include "canyon/app/epoch_pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <mutex>
 #include <optional>
@@ -11,6 +12,7 @@
 
 #include <readerwriterqueue/readerwritercircularbuffer.h>
 
+#include "canyon/app/cpu_affinity.hpp"
 #include "canyon/app/live_vio.hpp"
 #include "canyon/core/batch_queue.hpp"
 #include "canyon/core/time.hpp"
@@ -128,8 +130,35 @@ void FusionEstimator::resolve(EpochItem& item) {
 
 // ---- The pipeline ----
 
+bool PipelineOptions::pinned() const {
+  return std::any_of(cpu_affinity.begin(), cpu_affinity.end(), [](const auto& cpus) { return !cpus.empty(); });
+}
+
 std::string PipelineOptions::validate() const {
   if (queue_capacity < 1 || queue_capacity > 65536) return "queue_capacity must be in 1..65536";
+  for (std::size_t s = 0; s < kNumStages; ++s) {
+    for (const int cpu : cpu_affinity[s]) {
+      if (cpu < 0 || cpu > max_cpu_number()) {
+        return std::string("cpu_affinity.") + stage_name(static_cast<Stage>(s)) + ": CPU " + std::to_string(cpu) +
+               " is out of range 0.." + std::to_string(max_cpu_number());
+      }
+    }
+  }
+  if (pinned() && !threaded) return "cpu_affinity is for the threaded pipeline (threaded: true)";
+  return {};
+}
+
+std::string PipelineOptions::unavailable_cpu() const {
+  if (!pinned()) return {};
+  const std::vector<int> allowed = allowed_cpus();
+  for (std::size_t s = 0; s < kNumStages; ++s) {
+    for (const int cpu : cpu_affinity[s]) {
+      if (!std::binary_search(allowed.begin(), allowed.end(), cpu)) {
+        return std::string("cpu_affinity.") + stage_name(static_cast<Stage>(s)) + ": CPU " + std::to_string(cpu) +
+               " is not one this process may run on (" + cpu_list_text(allowed) + ")";
+      }
+    }
+  }
   return {};
 }
 
@@ -152,7 +181,7 @@ EpochPipeline::EpochPipeline(EpochSource& source, EpochEstimator& estimator, Epo
     : source_(source),
       estimator_(estimator),
       sink_(std::move(sink)),
-      options_(options),
+      options_(std::move(options)),
       observer_(std::move(observer)) {
   for (auto& w : full_waits_) w.store(0);
   if (options_.threaded) queues_ = std::make_unique<Queues>(options_.queue_capacity);
@@ -308,7 +337,17 @@ Status EpochPipeline::run_bridge_ahead() {
   return Ok{};
 }
 
+void EpochPipeline::pin(Stage stage) {
+  const std::vector<int>& cpus = options_.cpu_affinity[static_cast<std::size_t>(stage)];
+  if (cpus.empty()) return;
+  if (Status s = pin_this_thread(cpus); !s) {
+    fail(Error{std::string("pipeline: the ") + stage_name(stage) + " thread: " + s.error().message});
+  }
+}
+
 Status EpochPipeline::run_threaded() {
+  if (const std::string e = options_.unavailable_cpu(); !e.empty()) return Error{"pipeline: " + e};
+  const std::vector<int> caller_cpus = this_thread_cpus();  // this thread runs the last stage, then gets them back
   Queues& q = *queues_;
   const auto push = [this, &q](std::size_t i, ItemPtr item) {
     if (!q.between[i]->try_enqueue(std::move(item))) {
@@ -319,6 +358,7 @@ Status EpochPipeline::run_threaded() {
 
   // Ingest.
   std::thread ingest([this, &push] {
+    pin(Stage::Ingest);
     for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
       ItemPtr item = ingest_next(seq);
       if (!item) break;
@@ -331,6 +371,7 @@ Status EpochPipeline::run_threaded() {
   // Middle stages: time bridge, alignment (waits for the token), prediction, update.
   const auto middle = [this, &q, &push](Stage stage) {
     const auto in = static_cast<std::size_t>(stage) - 1;
+    pin(stage);
     bool first = true;
     for (;;) {
       ItemPtr item;
@@ -355,6 +396,7 @@ Status EpochPipeline::run_threaded() {
   std::thread update(middle, Stage::Update);
 
   // Ambiguity resolution and the sink, on this thread.
+  pin(Stage::Ambiguity);
   for (;;) {
     ItemPtr item;
     q.between[kNumStages - 2]->wait_dequeue(item);
@@ -372,6 +414,7 @@ Status EpochPipeline::run_threaded() {
   align.join();
   predict.join();
   update.join();
+  if (options_.pinned() && !caller_cpus.empty()) (void)pin_this_thread(caller_cpus);
   estimator_.finish();
   return Ok{};
 }

@@ -4,13 +4,36 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 
+#include "canyon/app/cpu_affinity.hpp"
 #include "canyon/app/yaml_reader.hpp"
 
 namespace canyon::app {
 namespace {
+
+/// pipeline.cpu_affinity: {STAGE: [CPU, ...]} for any of the six stages, into `pipeline`.
+void read_cpu_affinity(YamlMap map, PipelineOptions& pipeline) {
+  for (std::size_t s = 0; s < kNumStages; ++s) {
+    const char* name = stage_name(static_cast<Stage>(s));
+    std::vector<double> numbers;
+    map.get(name, numbers);
+    std::vector<int>& cpus = pipeline.cpu_affinity[s];
+    cpus.clear();
+    for (const double n : numbers) {
+      if (n != std::floor(n) || n < 0.0 || n > max_cpu_number()) {
+        map.fail(name, "CPU numbers are integers in 0.." + std::to_string(max_cpu_number()));
+        break;
+      }
+      cpus.push_back(static_cast<int>(n));
+    }
+    std::sort(cpus.begin(), cpus.end());
+    cpus.erase(std::unique(cpus.begin(), cpus.end()), cpus.end());
+  }
+  map.reject_unknown_keys();
+}
 
 constexpr std::array<std::pair<RoverBaseSource, const char*>, 4> kBaseSources{{
     {RoverBaseSource::File, "file"},
@@ -150,6 +173,7 @@ Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string
   int capacity = static_cast<int>(c.pipeline.queue_capacity);
   pipeline.get("queue_capacity", capacity);
   c.pipeline.queue_capacity = capacity < 0 ? 0 : static_cast<std::size_t>(capacity);
+  read_cpu_affinity(pipeline.sub("cpu_affinity"), c.pipeline);
   pipeline.reject_unknown_keys();
   YamlMap dds = top.sub("dds");
   dds.get("domain", c.domain);
@@ -196,6 +220,13 @@ std::string to_yaml(const RoverConfig& c) {
   out << YAML::Key << "pipeline" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "threaded" << YAML::Value << c.pipeline.threaded;
   out << YAML::Key << "queue_capacity" << YAML::Value << c.pipeline.queue_capacity;
+  out << YAML::Key << "cpu_affinity" << YAML::Value << YAML::BeginMap;
+  for (std::size_t s = 0; s < kNumStages; ++s) {
+    const std::vector<int>& cpus = c.pipeline.cpu_affinity[s];
+    if (cpus.empty()) continue;
+    out << YAML::Key << stage_name(static_cast<Stage>(s)) << YAML::Value << YAML::Flow << cpus;
+  }
+  out << YAML::EndMap;
   out << YAML::EndMap;
   out << YAML::Key << "dds" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "domain" << YAML::Value << c.domain;

@@ -18,6 +18,7 @@
 #include <readerwriterqueue/readerwritercircularbuffer.h>
 #include <spdlog/spdlog.h>
 
+#include "canyon/app/cpu_affinity.hpp"
 #include "canyon/app/epoch_pipeline.hpp"
 #include "canyon/app/live_vio.hpp"
 #include "canyon/app/observation_stream.hpp"
@@ -226,12 +227,20 @@ int run(int argc, char** argv) {
   if (pace >= 0.0) config->pace = pace;
   if (!out.empty()) config->estimator.out = out;
   if (!pipeline_mode.empty()) config->pipeline.threaded = pipeline_mode == "threaded";
+  if (!pipeline_mode.empty() && !config->pipeline.threaded && config->pipeline.pinned()) {
+    spdlog::warn("pipeline.cpu_affinity applies to the threaded pipeline only: ignored with --pipeline sequential");
+    config->pipeline.cpu_affinity = {};
+  }
   if (print_config) {
     std::cout << app::to_yaml(*config);
     return 0;
   }
   if (const std::string e = config->validate(); !e.empty()) {
     spdlog::error("{}: {}", config_file, e);
+    return kExitUsage;
+  }
+  if (const std::string e = config->pipeline.unavailable_cpu(); !e.empty()) {
+    spdlog::error("{}: pipeline.{}", config_file, e);
     return kExitUsage;
   }
   const app::ProcessConfig& est = config->estimator;
@@ -478,6 +487,12 @@ int run(int argc, char** argv) {
       base_from + (config->vio_dds ? ", VIO from DDS " + config->vio_topic + " and " + config->timesync_topic : ""),
       config->pipeline.threaded ? "threaded" : "sequential", config->pace, config->solution_topic, config->timing_topic,
       config->domain);
+  for (std::size_t s = 0; s < app::kNumStages; ++s) {
+    const std::vector<int>& cpus = config->pipeline.cpu_affinity[s];
+    if (!cpus.empty()) {
+      spdlog::info("{} stage thread on CPU {}", app::stage_name(static_cast<app::Stage>(s)), app::cpu_list_text(cpus));
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   Status status = pipeline.run();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

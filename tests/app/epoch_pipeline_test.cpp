@@ -4,7 +4,8 @@
 //  - queues: a full queue blocks its producer (counted, nothing dropped, order kept); empty queues wait;
 //  - stop() with epochs in flight: every epoch ingested reaches the sink, run() returns cleanly;
 //  - a failing source or sink stops the pipeline with its error, without hanging;
-//  - the stage observer's two steps (taken, handed_on), per epoch, on each stage's thread.
+//  - the stage observer's two steps (taken, handed_on), per epoch, on each stage's thread;
+//  - pinned stage threads (pipeline.cpu_affinity) run where they are told, and give the same solutions.
 
 #include "canyon/app/epoch_pipeline.hpp"
 
@@ -19,7 +20,9 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
+#include "canyon/app/cpu_affinity.hpp"
 #include "canyon/app/process.hpp"
 #include "canyon/app/process_config.hpp"
 #include "canyon/app/scenario_config.hpp"
@@ -51,12 +54,24 @@ std::vector<std::string> without_cpu_times(std::vector<std::string> lines) {
   return lines;
 }
 
-/// The layouts: one thread, two (ingest and time bridge ahead), six threads.
+/// Six threads, ingest and the time bridge on the first CPU this process may use, the estimator's four stages on
+/// its last (the same CPU on a one-CPU machine).
+PipelineOptions pinned_threaded() {
+  PipelineOptions options{true, 4};
+  const std::vector<int> cpus = allowed_cpus();
+  for (std::size_t s = 0; s < kNumStages; ++s) {
+    options.cpu_affinity[s] = {s <= static_cast<std::size_t>(Stage::TimeBridge) ? cpus.front() : cpus.back()};
+  }
+  return options;
+}
+
+/// The layouts: one thread, two (ingest and time bridge ahead), six threads, six threads pinned to CPUs.
 const std::vector<std::pair<std::string, PipelineOptions>>& layouts() {
   static const std::vector<std::pair<std::string, PipelineOptions>> all{
       {"sequential", PipelineOptions{false, 64}},
       {"bridge-ahead", PipelineOptions{false, 4, true}},
       {"threaded", PipelineOptions{true, 4}},
+      {"threaded-pinned", pinned_threaded()},
   };
   return all;
 }
@@ -94,9 +109,10 @@ TEST(EpochPipeline, EveryLayoutEqualsSequentialRtkInstinct) {
   config->nav = {(data / "RINEX_GN_Spirent.23N").string()};
   const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  ASSERT_EQ(others.size(), 2U);
+  ASSERT_EQ(others.size(), 3U);
   EXPECT_TRUE(seq == others[0]) << "bridge-ahead .pos differs from sequential";
   EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
+  EXPECT_TRUE(seq == others[2]) << "pinned threaded .pos differs from sequential";
 }
 
 TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
@@ -115,9 +131,10 @@ TEST(EpochPipeline, EveryLayoutEqualsSequentialFusionUrbanSevere) {
   config->timesync = (dir / "timesync.csv").string();
   const auto [seq, others] = every_way(*config, dir);
   EXPECT_GT(seq.size(), 10000U);
-  ASSERT_EQ(others.size(), 2U);
+  ASSERT_EQ(others.size(), 3U);
   EXPECT_TRUE(seq == others[0]) << "bridge-ahead .pos differs from sequential";
   EXPECT_TRUE(seq == others[1]) << "threaded .pos differs from sequential";
+  EXPECT_TRUE(seq == others[2]) << "pinned threaded .pos differs from sequential";
 }
 
 // ---- Queues and shutdown, with a fake source and estimator ----
@@ -344,6 +361,41 @@ TEST(EpochPipeline, ObserverTakesThenHandsOnEachEpochOnItsStageThread) {
       EXPECT_GE(last.sunk_when_handed_on[k], static_cast<int>(k) + 1) << name << ": handed on before its sink";
     }
   }
+}
+
+// pipeline.cpu_affinity: each stage's thread runs on its CPUs only; the caller's thread (which runs the ambiguity
+// stage) gets its CPUs back; a CPU the process may not use is refused before any epoch is read.
+TEST(EpochPipeline, PinnedStageThreadsRunOnTheirCpus) {
+  const PipelineOptions options = pinned_threaded();
+  const std::vector<int> caller_before = this_thread_cpus();
+  CountingSource source(50, std::chrono::microseconds(0));
+  RecordingEstimator estimator;
+  std::array<std::set<int>, kNumStages> cpus_seen;  // each written by its stage's thread only
+  StageObserver observer;
+  observer.taken = [&cpus_seen](Stage stage, const EpochItem&) {
+    cpus_seen[static_cast<std::size_t>(stage)].insert(sched_getcpu());
+  };
+  EpochPipeline pipeline(
+      source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, options, observer);
+  ASSERT_TRUE(pipeline.run().ok());
+  for (std::size_t s = 0; s < kNumStages; ++s) {
+    const std::set<int> pinned(options.cpu_affinity[s].begin(), options.cpu_affinity[s].end());
+    EXPECT_EQ(cpus_seen[s], pinned) << stage_name(static_cast<Stage>(s));
+  }
+  EXPECT_EQ(this_thread_cpus(), caller_before);
+
+  PipelineOptions far{true, 4};
+  far.cpu_affinity[static_cast<std::size_t>(Stage::Update)] = {max_cpu_number()};
+  ASSERT_EQ(far.validate(), "");
+  CountingSource unread(5, std::chrono::microseconds(0));
+  EpochPipeline refused(
+      unread, estimator, [](const EpochItem&) -> Status { return Ok{}; }, far);
+  const Status s = refused.run();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("pipeline: cpu_affinity.update: CPU 1023 is not one this process may run on"),
+            std::string::npos)
+      << s.error().message;
+  EXPECT_EQ(unread.produced_.load(), 0);
 }
 
 void expect_stop_finishes_the_epochs_in_flight(const PipelineOptions& options) {

@@ -2,7 +2,11 @@
 
 #include "canyon/app/rover_config.hpp"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
+
+#include "canyon/app/cpu_affinity.hpp"
 
 namespace canyon::app {
 namespace {
@@ -115,6 +119,47 @@ TEST(RoverConfig, VioFromDds) {
                 .find("needs estimator.mode fusion"),
             std::string::npos);
   EXPECT_NE(error(fusion).find("vio"), std::string::npos);  // from files, the files are required
+}
+
+TEST(RoverConfig, StageThreadCpuAffinity) {
+  const std::string rtk = "estimator: {mode: rtk, rover: r.obs, base: b.obs, nav: [n.rnx]}\n";
+  const auto parse = [](const std::string& yaml) { return parse_rover_config(YAML::Load(yaml), "rover.yaml"); };
+  const auto error = [&parse](const std::string& yaml) {
+    auto c = parse(yaml);
+    if (!c) return c.error().to_string();
+    return c->validate();
+  };
+  auto c = parse(rtk + "pipeline: {cpu_affinity: {ingest: [0], alignment: [1, 0, 1], ambiguity: [1]}}\n");
+  ASSERT_TRUE(c) << c.error().to_string();
+  EXPECT_EQ(c->validate(), "");
+  EXPECT_TRUE(c->pipeline.pinned());
+  EXPECT_EQ(c->pipeline.cpu_affinity[static_cast<std::size_t>(Stage::Ingest)], std::vector<int>{0});
+  EXPECT_EQ(c->pipeline.cpu_affinity[static_cast<std::size_t>(Stage::Alignment)], (std::vector<int>{0, 1}));
+  EXPECT_TRUE(c->pipeline.cpu_affinity[static_cast<std::size_t>(Stage::TimeBridge)].empty());
+  auto again = parse_rover_config(YAML::Load(to_yaml(*c)), "printed");
+  ASSERT_TRUE(again) << again.error().to_string();
+  EXPECT_TRUE(*again == *c);
+  EXPECT_FALSE(parse(rtk)->pipeline.pinned());  // the default: the OS places every thread
+
+  EXPECT_NE(error(rtk + "pipeline: {cpu_affinity: {alignmnet: [1]}}\n").find("pipeline.cpu_affinity.alignmnet"),
+            std::string::npos);
+  EXPECT_NE(error(rtk + "pipeline: {cpu_affinity: {update: [1.5]}}\n").find("integers in 0..1023"), std::string::npos);
+  EXPECT_NE(error(rtk + "pipeline: {cpu_affinity: {update: [-1]}}\n").find("integers in 0..1023"), std::string::npos);
+  EXPECT_NE(error(rtk + "pipeline: {cpu_affinity: {update: 1}}\n").find("pipeline.cpu_affinity.update"),
+            std::string::npos);
+  EXPECT_NE(error(rtk + "pipeline: {threaded: false, cpu_affinity: {update: [0]}}\n").find("threaded: true"),
+            std::string::npos);
+  // A CPU this process may not run on is found before the rover starts.
+  auto far = parse(rtk + "pipeline: {cpu_affinity: {prediction: [1023]}}\n");
+  ASSERT_TRUE(far) << far.error().to_string();
+  EXPECT_EQ(far->validate(), "");
+  EXPECT_NE(
+      far->pipeline.unavailable_cpu().find("cpu_affinity.prediction: CPU 1023 is not one this process may run on"),
+      std::string::npos);
+  const std::vector<int> allowed = allowed_cpus();
+  const bool has_0_and_1 =
+      std::binary_search(allowed.begin(), allowed.end(), 0) && std::binary_search(allowed.begin(), allowed.end(), 1);
+  EXPECT_EQ(c->pipeline.unavailable_cpu().empty(), has_0_and_1);
 }
 
 }  // namespace

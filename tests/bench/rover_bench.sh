@@ -10,7 +10,8 @@
 # Usage: tests/bench/rover_bench.sh {throughput|latency|scale|memory|all} [BUILD_DIR] [WORK_DIR]
 #   env: THROUGHPUT_S (600 s of data), LATENCY_S (120), SCALE_S (120), ROVERS (16), SUBSCRIBERS (4), MEMORY_S (1800),
 #        MEMORY_PACE (0: as fast as possible), DOMAIN (default 150 + PID % 80), PIPELINE_THREADED (true; false runs
-#        the rovers' stages on one thread)
+#        the rovers' stages on one thread), PIPELINE_AFFINITY (the rovers' pipeline.cpu_affinity, e.g. "{ingest: [0],
+#        time_bridge: [0], alignment: [1], prediction: [1], update: [1], ambiguity: [1]}"; default: none)
 set -uo pipefail
 
 what="${1:-all}"
@@ -53,7 +54,7 @@ rover_yaml() {
   echo "  base_position: [$(header_position "${sim}/base.obs")]"
   echo "rover_id: $5"
   echo "input: {pace: $4, base: $3, base_wait_s: 5}"
-  echo "pipeline: {threaded: ${PIPELINE_THREADED:-true}, queue_capacity: 64}"
+  echo "pipeline: {threaded: ${PIPELINE_THREADED:-true}, queue_capacity: 64${PIPELINE_AFFINITY:+, cpu_affinity: ${PIPELINE_AFFINITY}}}"
   echo "dds: {domain: ${domain}, profiles: ${profiles}}"
 }
 
@@ -105,17 +106,35 @@ throughput() {
   rover_run=$(sed -n 's/.* epochs, .* in \([0-9.]*\) s (\([0-9]*\) epochs\/s).*/\2 epochs\/s in its pipeline (\1 s)/p' "${sim}/rover.log")
   local rover_s
   rover_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
+  # The same rover with its stage threads pinned: ingest and the time bridge on one CPU, the estimator's four stages
+  # on another (pipeline.cpu_affinity), when this process may use two.
+  local cpus pinned_run="" pinned_s=""
+  read -r -a cpus <<< "$(taskset -pc $$ | sed 's/.*: //; s/,/ /g' | awk '{ for (i = 1; i <= NF; ++i) {
+    n = split($i, r, "-"); if (n == 1) print r[1]; else for (c = r[1]; c <= r[2]; ++c) print c } }' | tr '\n' ' ')"
+  if ((${#cpus[@]} >= 2)); then
+    local a="${cpus[0]}" b="${cpus[1]}"
+    PIPELINE_AFFINITY="{ingest: [${a}], time_bridge: [${a}], alignment: [${b}], prediction: [${b}], update: [${b}], ambiguity: [${b}]}" \
+      rover_yaml "${work}" "${sim}" file 0 thr > "${sim}/rover_pinned.yaml"
+    t0=$(date +%s.%N)
+    "${canyon}" rover --config "${sim}/rover_pinned.yaml" > "${sim}/rover_pinned.log" 2>&1
+    t1=$(date +%s.%N)
+    pinned_run=$(sed -n 's/.* epochs, .* in \([0-9.]*\) s (\([0-9]*\) epochs\/s).*/\2 epochs\/s in its pipeline (\1 s)/p' \
+      "${sim}/rover_pinned.log")
+    pinned_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
+  fi
   t0=$(date +%s.%N)
   rnx2rtkp -k "${root}/config/rtklib/sim.conf" -o "${sim}/rtklib.pos" "${sim}/rover.obs" "${sim}/base.obs" \
     "${sim}/nav.rnx" 2> /dev/null
   t1=$(date +%s.%N)
   local rtklib_s
   rtklib_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
-  awk -v n="${epochs}" -v p="${process_s}" -v a="${ahead_s}" -v r="${rover_s}" -v k="${rtklib_s}" -v rr="${rover_run}" 'BEGIN {
+  awk -v n="${epochs}" -v p="${process_s}" -v a="${ahead_s}" -v r="${rover_s}" -v k="${rtklib_s}" -v rr="${rover_run}" \
+    -v ps="${pinned_s}" -v pr="${pinned_run}" 'BEGIN {
     printf "throughput: %d epochs (urban-severe, %s s of 5 Hz data, fusion)\n", n, n / 5
     printf "  canyon process (bridge-ahead, two threads): %.2f s, %.0f epochs/s, %.1fx rnx2rtkp\n", a, n / a, k / a
     printf "  canyon process --pipeline threaded: %.2f s, %.0f epochs/s\n", p, n / p
     printf "  canyon rover (threaded, DDS out, pace 0): %.2f s with start-up, %.0f epochs/s; %s\n", r, n / r, rr
+    if (ps != "") printf "  canyon rover, stage threads pinned (pipeline.cpu_affinity): %.2f s with start-up, %.0f epochs/s; %s\n", ps, n / ps, pr
     printf "  rnx2rtkp (RTK only, config/rtklib/sim.conf): %.2f s, %.0f epochs/s; canyon rover %.1fx, process %.1fx\n",
       k, n / k, k / r, k / p }'
   throughput_instinct

@@ -206,7 +206,15 @@ struct PipelineOptions {
   /// stages (which stay on the caller's thread, one after the other), handing the epochs over in batches. Off:
   /// all six stages on the caller's thread.
   bool bridge_ahead = false;
+  /// Threaded only: by Stage, the CPUs that stage's thread may run on (empty: wherever the OS schedules it). With
+  /// alignment, prediction, update and ambiguity resolution on one CPU, an epoch's hand-offs between them wake a
+  /// thread on the same CPU instead of another CPU's.
+  std::array<std::vector<int>, kNumStages> cpu_affinity{};
+  [[nodiscard]] bool pinned() const;  ///< some stage has CPUs in cpu_affinity
   [[nodiscard]] std::string validate() const;
+  /// "" if every CPU of cpu_affinity is one this process may run on (this machine's, and not excluded by taskset or
+  /// a container); else which stage names which CPU.
+  [[nodiscard]] std::string unavailable_cpu() const;
 };
 
 struct PipelineStats {
@@ -239,6 +247,8 @@ class EpochPipeline {
   Status run_sequential();
   Status run_bridge_ahead();
   Status run_threaded();
+  /// Restricts the calling thread to `stage`'s CPUs, if it has any (a refusal by the kernel fails the run).
+  void pin(Stage stage);
   /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
   void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
   /// The ingest stage of the threaded layouts: the source's next epoch, stamped (ingested()); nullptr at the end of
