@@ -2,10 +2,10 @@
 
 #include "canyon/app/cpu_affinity.hpp"
 
+#include <cstring>
+
 #include <pthread.h>
 #include <sched.h>
-
-#include <cstring>
 
 namespace canyon::app {
 namespace {

@@ -10,11 +10,10 @@
 #include <utility>
 #include <vector>
 
-#include <readerwriterqueue/readerwritercircularbuffer.h>
-
 #include "canyon/app/cpu_affinity.hpp"
 #include "canyon/app/live_vio.hpp"
 #include "canyon/core/batch_queue.hpp"
+#include "canyon/core/spsc_handoff.hpp"
 #include "canyon/core/time.hpp"
 
 namespace canyon::app {
@@ -165,15 +164,14 @@ std::string PipelineOptions::unavailable_cpu() const {
 using ItemPtr = std::unique_ptr<EpochItem>;  // nullptr: end of the stream
 /// Epochs per hand-over in the bridge-ahead pipeline.
 constexpr std::size_t kBridgeAheadBatch = 4;
-using ItemQueue = moodycamel::BlockingReaderWriterCircularBuffer<ItemPtr>;
+using ItemQueue = core::SpscHandoff<ItemPtr>;
 
 struct EpochPipeline::Queues {
   explicit Queues(std::size_t capacity) {
     for (auto& q : between) q = std::make_unique<ItemQueue>(capacity);
   }
   std::array<std::unique_ptr<ItemQueue>, kNumStages - 1> between;  // stage i -> stage i + 1
-  moodycamel::BlockingReaderWriterCircularBuffer<bool> tokens{
-      2};  // ambiguity -> alignment: the estimator state is free for the next epoch
+  core::SpscHandoff<bool> tokens{2};  // ambiguity -> alignment: the estimator state is free for the next epoch
 };
 
 EpochPipeline::EpochPipeline(EpochSource& source, EpochEstimator& estimator, EpochSink sink, PipelineOptions options,
@@ -350,10 +348,7 @@ Status EpochPipeline::run_threaded() {
   const std::vector<int> caller_cpus = this_thread_cpus();  // this thread runs the last stage, then gets them back
   Queues& q = *queues_;
   const auto push = [this, &q](std::size_t i, ItemPtr item) {
-    if (!q.between[i]->try_enqueue(std::move(item))) {
-      ++full_waits_[i];
-      q.between[i]->wait_enqueue(std::move(item));  // never drops: back-pressure
-    }
+    if (q.between[i]->push(std::move(item))) ++full_waits_[i];  // never drops: back-pressure
   };
 
   // Ingest.
@@ -374,14 +369,10 @@ Status EpochPipeline::run_threaded() {
     pin(stage);
     bool first = true;
     for (;;) {
-      ItemPtr item;
-      q.between[in]->wait_dequeue(item);
+      ItemPtr item = q.between[in]->pop();
       if (!item) break;
       if (stage == Stage::Alignment) {
-        if (!first) {
-          bool token = false;
-          q.tokens.wait_dequeue(token);
-        }
+        if (!first) (void)q.tokens.pop();
         first = false;
       }
       run_stage(stage, *item);
@@ -398,11 +389,10 @@ Status EpochPipeline::run_threaded() {
   // Ambiguity resolution and the sink, on this thread.
   pin(Stage::Ambiguity);
   for (;;) {
-    ItemPtr item;
-    q.between[kNumStages - 2]->wait_dequeue(item);
+    ItemPtr item = q.between[kNumStages - 2]->pop();
     if (!item) break;
     run_stage(Stage::Ambiguity, *item);
-    q.tokens.wait_enqueue(true);  // the estimator is free for the next epoch's alignment
+    (void)q.tokens.push(true);  // the estimator is free for the next epoch's alignment
     ++epochs_;
     if (!failed_.load()) {
       if (Status w = sink_(*item); !w) fail(w.error());

@@ -547,9 +547,16 @@ int run(int argc, char** argv) {
   }
   const app::PipelineStats stats = pipeline.stats();
   std::uint64_t waits = 0;
-  for (const auto w : stats.full_waits) waits += w;
-  spdlog::info("{} epochs, {} solved, {} fixed in {:.3f} s ({:.0f} epochs/s); queue-full waits {}{}", epochs, solved,
-               fixed, wall_s, wall_s > 0 ? static_cast<double>(epochs) / wall_s : 0.0, waits,
+  std::string by_producer;  // each queue's waits, named by the stage that fills it
+  for (std::size_t i = 0; i < stats.full_waits.size(); ++i) {
+    waits += stats.full_waits[i];
+    if (stats.full_waits[i] == 0) continue;
+    by_producer += (by_producer.empty() ? " (" : ", ") + std::string(app::stage_name(static_cast<app::Stage>(i))) +
+                   " " + std::to_string(stats.full_waits[i]);
+  }
+  if (!by_producer.empty()) by_producer += ")";
+  spdlog::info("{} epochs, {} solved, {} fixed in {:.3f} s ({:.0f} epochs/s); queue-full waits {}{}{}", epochs, solved,
+               fixed, wall_s, wall_s > 0 ? static_cast<double>(epochs) / wall_s : 0.0, waits, by_producer,
                g_stop.load() ? " (stopped by signal)" : "");
   if (!status.ok()) {
     spdlog::error("{}", status.error().to_string());
