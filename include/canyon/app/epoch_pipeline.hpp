@@ -24,7 +24,8 @@
 // `canyon process` from about 37 to 28 ms on the 2-core development VM, where six threads are slower than one.
 //
 // Queue policy: GNSS epochs are never dropped. A full queue blocks its producer (back-pressure up to ingest, which
-// then reads its input later); each time a producer finds its queue full is counted (PipelineStats::full_waits).
+// then reads its input later) until the consumer has taken it down to half (core::SpscHandoff); each time a producer
+// finds its queue full is counted (PipelineStats::full_waits). PipelineOptions::cpu_affinity pins stage threads.
 // Stop (stop()): ingest stops reading; every epoch already ingested goes through every stage and reaches the sink.
 // Ephemerides that arrive while running (EpochItem::navigation, rare: a satellite's new ephemeris every hour or two)
 // drain the pipeline: that epoch enters the time bridge once every earlier epoch has left the last stage.
