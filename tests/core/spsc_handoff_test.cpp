@@ -37,9 +37,9 @@ void expect_all_in_order(std::size_t capacity, int n, int producer_pause, int co
 
 TEST(SpscHandoff, DeliversEveryItemInOrderWhicheverSideIsFaster) {
   for (const std::size_t capacity : {1U, 2U, 7U, 64U}) {
-    expect_all_in_order(capacity, 50000, 0, 0);   // both flat out: the wake-ups race the sleeps
-    expect_all_in_order(capacity, 2000, 7, 0);    // the consumer waits for items
-    expect_all_in_order(capacity, 2000, 0, 7);    // the producer waits for space
+    expect_all_in_order(capacity, 50000, 0, 0);  // both flat out: the wake-ups race the sleeps
+    expect_all_in_order(capacity, 2000, 7, 0);   // the consumer waits for items
+    expect_all_in_order(capacity, 2000, 0, 7);   // the producer waits for space
   }
 }
 

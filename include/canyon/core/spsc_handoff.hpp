@@ -13,10 +13,9 @@
 #include <utility>
 
 #include <linux/futex.h>
+#include <readerwriterqueue/readerwritercircularbuffer.h>
 #include <sys/syscall.h>
 #include <unistd.h>
-
-#include <readerwriterqueue/readerwritercircularbuffer.h>
 
 namespace canyon::core {
 
