@@ -77,6 +77,23 @@ print("p50 %.0f / p95 %.0f / p99 %.0f / max %.0f us (%d samples)" % (p["p50_us"]
 ' "$1" "$2"
 }
 
+# allowed_cpus: the CPUs this shell may run on, space-separated ("0-2,5" -> "0 1 2 5").
+allowed_cpus() {
+  taskset -pc $$ | sed 's/.*: //; s/,/ /g' | awk '{ for (i = 1; i <= NF; ++i) {
+    n = split($i, r, "-"); if (n == 1) print r[1]; else for (c = r[1]; c <= r[2]; ++c) print c } }' | tr '\n' ' '
+}
+
+# timed_rover YAML LOG: canyon rover on YAML, its output to LOG; sets rover_wall_s (the whole process, start-up
+# included) and rover_pipeline ("N epochs/s in its pipeline (S s)", from the rover's summary line).
+timed_rover() {
+  local t0 t1
+  t0=$(date +%s.%N)
+  "${canyon}" rover --config "$1" > "$2" 2>&1
+  t1=$(date +%s.%N)
+  rover_pipeline=$(sed -n 's/.* epochs, .* in \([0-9.]*\) s (\([0-9]*\) epochs\/s).*/\2 epochs\/s in its pipeline (\1 s)/p' "$2")
+  rover_wall_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
+}
+
 throughput() {
   local seconds="${THROUGHPUT_S:-600}"
   simulate thr "${seconds}" 1
@@ -99,28 +116,18 @@ throughput() {
   local ahead_s
   ahead_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
   rover_yaml "${work}" "${sim}" file 0 thr > "${sim}/rover.yaml"
-  t0=$(date +%s.%N)
-  "${canyon}" rover --config "${sim}/rover.yaml" > "${sim}/rover.log" 2>&1
-  t1=$(date +%s.%N)
-  local rover_run
-  rover_run=$(sed -n 's/.* epochs, .* in \([0-9.]*\) s (\([0-9]*\) epochs\/s).*/\2 epochs\/s in its pipeline (\1 s)/p' "${sim}/rover.log")
-  local rover_s
-  rover_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
+  timed_rover "${sim}/rover.yaml" "${sim}/rover.log"
+  local rover_run="${rover_pipeline}" rover_s="${rover_wall_s}"
   # The same rover with its stage threads pinned: ingest and the time bridge on one CPU, the estimator's four stages
   # on another (pipeline.cpu_affinity), when this process may use two.
   local cpus pinned_run="" pinned_s=""
-  read -r -a cpus <<< "$(taskset -pc $$ | sed 's/.*: //; s/,/ /g' | awk '{ for (i = 1; i <= NF; ++i) {
-    n = split($i, r, "-"); if (n == 1) print r[1]; else for (c = r[1]; c <= r[2]; ++c) print c } }' | tr '\n' ' ')"
+  read -r -a cpus <<< "$(allowed_cpus)"
   if ((${#cpus[@]} >= 2)); then
     local a="${cpus[0]}" b="${cpus[1]}"
     PIPELINE_AFFINITY="{ingest: [${a}], time_bridge: [${a}], alignment: [${b}], prediction: [${b}], update: [${b}], ambiguity: [${b}]}" \
       rover_yaml "${work}" "${sim}" file 0 thr > "${sim}/rover_pinned.yaml"
-    t0=$(date +%s.%N)
-    "${canyon}" rover --config "${sim}/rover_pinned.yaml" > "${sim}/rover_pinned.log" 2>&1
-    t1=$(date +%s.%N)
-    pinned_run=$(sed -n 's/.* epochs, .* in \([0-9.]*\) s (\([0-9]*\) epochs\/s).*/\2 epochs\/s in its pipeline (\1 s)/p' \
-      "${sim}/rover_pinned.log")
-    pinned_s=$(awk -v a="${t0}" -v b="${t1}" 'BEGIN { print b - a }')
+    timed_rover "${sim}/rover_pinned.yaml" "${sim}/rover_pinned.log"
+    pinned_run="${rover_pipeline}" pinned_s="${rover_wall_s}"
   fi
   t0=$(date +%s.%N)
   rnx2rtkp -k "${root}/config/rtklib/sim.conf" -o "${sim}/rtklib.pos" "${sim}/rover.obs" "${sim}/base.obs" \

@@ -7,6 +7,7 @@
 // The buffer's own blocking calls wake a full producer at every freed slot: at full speed that is a wake-up, and across
 // CPUs an inter-processor interrupt, per item. Here a full queue costs one per half a queue of items.
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -24,7 +25,7 @@ class SpscHandoff {
  public:
   /// Holds at most `capacity` items (at least 1); a full producer wakes again at capacity / 2.
   explicit SpscHandoff(std::size_t capacity)
-      : ring_(capacity < 1 ? 1 : capacity), low_water_((capacity < 1 ? 1 : capacity) / 2) {}
+      : ring_(std::max<std::size_t>(capacity, 1)), low_water_(std::max<std::size_t>(capacity, 1) / 2) {}
 
   /// Producer: queues `item`, sleeping while the queue is full. True if it found the queue full and waited.
   bool push(T item) {
