@@ -12,10 +12,10 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
-#include "canyon/app/base_config.hpp"
-#include "canyon/app/base_station.hpp"
-#include "canyon/pipeline/dds.hpp"
-#include "canyon/pipeline/rtcm_frame.hpp"
+#include "canyon/base/base_station.hpp"
+#include "canyon/config/base_config.hpp"
+#include "canyon/dds/dds.hpp"
+#include "canyon/dds/rtcm_frame.hpp"
 
 #include "main_guard.hpp"
 
@@ -24,10 +24,10 @@ namespace {
 constexpr int kExitRuntime = 1;
 constexpr int kExitUsage = 2;
 
-std::atomic<canyon::app::BaseStation*> g_base{nullptr};
+std::atomic<canyon::base::BaseStation*> g_base{nullptr};
 
 extern "C" void on_signal(int /*signal*/) {
-  if (canyon::app::BaseStation* base = g_base.load()) base->stop();
+  if (canyon::base::BaseStation* base = g_base.load()) base->stop();
 }
 
 int run(int argc, char** argv) {
@@ -63,7 +63,7 @@ int run(int argc, char** argv) {
   spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [canyon-base] [%^%l%$] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
 
-  auto config = canyon::app::load_base_config(config_file);
+  auto config = canyon::config::load_base_config(config_file);
   if (!config) {
     spdlog::error("{}", config.error().to_string());
     return kExitUsage;
@@ -72,7 +72,7 @@ int run(int argc, char** argv) {
   if (tcp_port >= 0) config->tcp.port = tcp_port;
   if (pace >= 0) config->input.pace = pace;
   if (print_config) {
-    std::cout << canyon::app::to_yaml(*config);
+    std::cout << canyon::config::to_yaml(*config);
     return 0;
   }
   if (const std::string e = config->validate(); !e.empty()) {
@@ -81,20 +81,20 @@ int run(int argc, char** argv) {
   }
 
   // DDS first: its profiles must be loaded before any participant exists.
-  std::unique_ptr<canyon::pipeline::DdsParticipant> participant;
-  std::unique_ptr<canyon::pipeline::RtcmWriter> writer;
+  std::unique_ptr<canyon::dds::DdsParticipant> participant;
+  std::unique_ptr<canyon::dds::RtcmWriter> writer;
   if (config->dds.enabled) {
-    if (auto s = canyon::pipeline::load_profiles_or_default(config->dds.profiles); !s.ok()) {
+    if (auto s = canyon::dds::load_profiles_or_default(config->dds.profiles); !s.ok()) {
       spdlog::error("{}", s.error().to_string());
       return kExitUsage;
     }
-    auto p = canyon::pipeline::DdsParticipant::create(config->dds.domain);
+    auto p = canyon::dds::DdsParticipant::create(config->dds.domain);
     if (!p) {
       spdlog::error("{}", p.error().to_string());
       return kExitRuntime;
     }
     participant = std::move(*p);
-    auto w = canyon::pipeline::RtcmWriter::create(*participant, config->dds.topic, "rtcm_writer");
+    auto w = canyon::dds::RtcmWriter::create(*participant, config->dds.topic, "rtcm_writer");
     if (!w) {
       spdlog::error("{}", w.error().to_string());
       return kExitRuntime;
@@ -104,16 +104,16 @@ int run(int argc, char** argv) {
                  config->dds.domain, config->dds.profiles.empty() ? "shipped" : config->dds.profiles);
   }
 
-  auto base = canyon::app::BaseStation::create(*config, [](const std::string& line) { spdlog::info("{}", line); });
+  auto base = canyon::base::BaseStation::create(*config, [](const std::string& line) { spdlog::info("{}", line); });
   if (!base) {
     spdlog::error("{}", base.error().to_string());
     return kExitRuntime;
   }
   std::uint64_t refused = 0;
   if (writer) {
-    canyon::pipeline::RtcmWriter* w = writer.get();
-    (*base)->add_sink([w, &refused](const canyon::app::BaseFrame& frame) {
-      if (!canyon::pipeline::publish_rtcm_frame(*w, frame)) ++refused;
+    canyon::dds::RtcmWriter* w = writer.get();
+    (*base)->add_sink([w, &refused](const canyon::base::BaseFrame& frame) {
+      if (!canyon::dds::publish_rtcm_frame(*w, frame)) ++refused;
     });
     (*base)->set_subscriber_count([w] { return w->matched(); });
   }

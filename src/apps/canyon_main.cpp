@@ -14,13 +14,13 @@
 #include <malloc.h>
 #include <unistd.h>
 
-#include "canyon/app/convert.hpp"
-#include "canyon/app/demo.hpp"
-#include "canyon/app/evaluate.hpp"
-#include "canyon/app/process.hpp"
-#include "canyon/app/process_config.hpp"
-#include "canyon/app/scenario_config.hpp"
-#include "canyon/app/simulate.hpp"
+#include "canyon/commands/convert.hpp"
+#include "canyon/commands/demo.hpp"
+#include "canyon/commands/evaluate.hpp"
+#include "canyon/commands/process.hpp"
+#include "canyon/commands/simulate.hpp"
+#include "canyon/config/process_config.hpp"
+#include "canyon/config/scenario_config.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/satellite.hpp"
 
@@ -125,10 +125,10 @@ void print_warnings(const std::vector<std::string>& warnings, bool verbose, cons
 }
 
 int run_process_command(const ProcessArgs& args) {
-  using canyon::app::ProcessConfig;
+  using canyon::config::ProcessConfig;
   ProcessConfig config;
   if (!args.config_file.empty()) {
-    auto loaded = canyon::app::load_process_config(args.config_file);
+    auto loaded = canyon::config::load_process_config(args.config_file);
     if (!loaded) {
       std::cerr << "canyon: error: " << loaded.error().to_string() << "\n";
       return kExitUsage;
@@ -136,9 +136,9 @@ int run_process_command(const ProcessArgs& args) {
     config = std::move(*loaded);
   }
   if (!args.mode.empty()) {
-    config.mode = args.mode == "rtk"      ? canyon::app::ProcessMode::Rtk
-                  : args.mode == "fusion" ? canyon::app::ProcessMode::Fusion
-                                          : canyon::app::ProcessMode::Spp;
+    config.mode = args.mode == "rtk"      ? canyon::config::ProcessMode::Rtk
+                  : args.mode == "fusion" ? canyon::config::ProcessMode::Fusion
+                                          : canyon::config::ProcessMode::Spp;
   }
   if (!args.rover.empty()) config.rover_obs = args.rover;
   if (!args.base.empty()) config.base_obs = args.base;
@@ -184,7 +184,7 @@ int run_process_command(const ProcessArgs& args) {
   }
   if (args.elevation_mask_deg >= 0.0) config.spp.elevation_mask_rad = args.elevation_mask_deg * canyon::core::kDegToRad;
   if (args.print_config) {
-    std::cout << canyon::app::to_yaml(config);
+    std::cout << canyon::config::to_yaml(config);
     return 0;
   }
   if (const std::string e = config.validate(); !e.empty()) {
@@ -192,10 +192,10 @@ int run_process_command(const ProcessArgs& args) {
     return kExitUsage;
   }
   ProgressBar bar(!args.quiet);
-  canyon::app::PipelineOptions pipeline;
+  canyon::pipeline::PipelineOptions pipeline;
   pipeline.threaded = args.pipeline == "threaded";
   pipeline.bridge_ahead = args.pipeline == "bridge-ahead";
-  auto summary = canyon::app::run_process(
+  auto summary = canyon::commands::run_process(
       config, [&bar](int epochs, double fraction) { bar.update(epochs, fraction); }, pipeline);
   bar.finish();
   if (!summary) {
@@ -221,7 +221,7 @@ int run_process_command(const ProcessArgs& args) {
   if (!args.quiet) {
     const double percent = summary->epochs > 0 ? 100.0 * summary->solved / summary->epochs : 0.0;
     std::string fixed;
-    if (config.mode != canyon::app::ProcessMode::Spp) {
+    if (config.mode != canyon::config::ProcessMode::Spp) {
       char buffer[64];
       std::snprintf(buffer, sizeof buffer, ", %d fixed (%.1f %%)", summary->fixed,
                     summary->epochs > 0 ? 100.0 * summary->fixed / summary->epochs : 0.0);
@@ -263,12 +263,12 @@ int run_vio_from_truth_command(const SimulateArgs& args) {
   canyon::sim::VioOptions vio;
   std::uint64_t seed = 1;
   if (!args.scenario.empty()) {
-    auto file = canyon::app::find_scenario_file(args.scenario);
+    auto file = canyon::config::find_scenario_file(args.scenario);
     if (!file) {
       std::cerr << "canyon: error: " << file.error().to_string() << "\n";
       return kExitUsage;
     }
-    auto scenario = canyon::app::load_scenario(*file);
+    auto scenario = canyon::config::load_scenario(*file);
     if (!scenario) {
       std::cerr << "canyon: error: " << scenario.error().to_string() << "\n";
       return kExitUsage;
@@ -277,7 +277,7 @@ int run_vio_from_truth_command(const SimulateArgs& args) {
     seed = scenario->seed;
   }
   if (args.seed >= 0) seed = static_cast<std::uint64_t>(args.seed);
-  auto summary = canyon::app::run_vio_from_truth(args.vio_from_truth, vio, seed, args.out);
+  auto summary = canyon::commands::run_vio_from_truth(args.vio_from_truth, vio, seed, args.out);
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
@@ -299,19 +299,19 @@ int run_simulate_command(const SimulateArgs& args) {
     std::cerr << "canyon: error: simulate needs --scenario (or --vio-from-truth TRUTH)\n";
     return kExitUsage;
   }
-  auto file = canyon::app::find_scenario_file(args.scenario);
+  auto file = canyon::config::find_scenario_file(args.scenario);
   if (!file) {
     std::cerr << "canyon: error: " << file.error().to_string() << "\n";
     return kExitUsage;
   }
-  auto scenario = canyon::app::load_scenario(*file);
+  auto scenario = canyon::config::load_scenario(*file);
   if (!scenario) {
     std::cerr << "canyon: error: " << scenario.error().to_string() << "\n";
     return kExitUsage;
   }
   if (args.seed >= 0) scenario->seed = static_cast<std::uint64_t>(args.seed);
   if (args.duration_s > 0.0) scenario->duration_s = args.duration_s;
-  auto summary = canyon::app::run_simulate(*scenario, args.out);
+  auto summary = canyon::commands::run_simulate(*scenario, args.out);
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
@@ -329,7 +329,7 @@ int run_simulate_command(const SimulateArgs& args) {
 }
 
 struct EvaluateArgs {
-  canyon::app::EvaluateConfig config;
+  canyon::commands::EvaluateConfig config;
   int epochs = 0;
   bool quiet = false;
 };
@@ -338,7 +338,7 @@ void add_evaluate_command(CLI::App& app, EvaluateArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "evaluate",
       "Score solutions (.pos, canyon's or RTKLIB's) against a truth, side by side: table, Markdown, JSON, SVG plots");
-  canyon::app::EvaluateConfig& c = args.config;
+  canyon::commands::EvaluateConfig& c = args.config;
   cmd->add_option("--truth", c.truth,
                   "Truth: canyon truth.csv, Spirent PVA .csv, a .pos file, or a static point ecef:X,Y,Z (m) or "
                   "llh:LAT,LON,H (deg, deg, m)")
@@ -379,7 +379,7 @@ int run_evaluate_command(EvaluateArgs& args) {
     std::cerr << "canyon: error: " << broken << "\n";
     return kExitUsage;
   }
-  auto summary = canyon::app::run_evaluate(args.config);
+  auto summary = canyon::commands::run_evaluate(args.config);
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;
@@ -394,7 +394,7 @@ int run_evaluate_command(EvaluateArgs& args) {
 }
 
 struct DemoArgs {
-  canyon::app::DemoConfig config;
+  canyon::commands::DemoConfig config;
   std::int64_t seed = -1;
   double duration_s = -1.0;
   bool no_rtklib = false;
@@ -405,7 +405,7 @@ void add_demo_command(CLI::App& app, DemoArgs& args) {
       "demo",
       "canyon's main job, no external data: generate urban-severe, process it with SPP, RTK, fusion (VIO) and RTKLIB, "
       "evaluate");
-  canyon::app::DemoConfig& c = args.config;
+  canyon::commands::DemoConfig& c = args.config;
   cmd->add_option("--scenario", c.scenario, "Shipped scenario name or a FILE.yaml (default urban-severe)");
   cmd->add_option("--seed", args.seed, "Random seed (default: the scenario's)")->check(CLI::Range(0LL, 1LL << 53));
   cmd->add_option("--duration", args.duration_s, "Duration in seconds (default: the scenario's, 600)")
@@ -423,16 +423,16 @@ void add_demo_command(CLI::App& app, DemoArgs& args) {
 }
 
 int run_demo_command(DemoArgs& args) {
-  canyon::app::DemoConfig& c = args.config;
+  canyon::commands::DemoConfig& c = args.config;
   if (args.seed >= 0) c.seed = static_cast<std::uint64_t>(args.seed);
   if (args.duration_s > 0.0) c.duration_s = args.duration_s;
   c.run_rtklib = !args.no_rtklib;
-  auto scenario = canyon::app::find_scenario_file(c.scenario);
+  auto scenario = canyon::config::find_scenario_file(c.scenario);
   if (!scenario) {
     std::cerr << "canyon: error: " << scenario.error().to_string() << "\n";
     return kExitUsage;
   }
-  auto summary = canyon::app::run_demo(
+  auto summary = canyon::commands::run_demo(
       c, [](const std::string& stage) { std::fprintf(stderr, "canyon demo: %s\n", stage.c_str()); });
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
@@ -447,7 +447,7 @@ int run_demo_command(DemoArgs& args) {
 }
 
 struct ConvertArgs {
-  canyon::app::ConvertConfig config;
+  canyon::commands::ConvertConfig config;
   std::string time;
   std::string position;
   bool quiet = false;
@@ -457,7 +457,7 @@ struct ConvertArgs {
 void add_convert_command(CLI::App& app, ConvertArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "convert", "RTCM 3 or u-blox UBX (file or stdin) -> RINEX 3 observations and navigation; RINEX -> RTCM 3");
-  canyon::app::ConvertConfig& c = args.config;
+  canyon::commands::ConvertConfig& c = args.config;
   cmd->add_option("input", c.input,
                   "Input: RTCM 3 / UBX stream file (may be .gz; '-' reads stdin; tcp://HOST:PORT or "
                   "ntrip://[USER[:PASS]@]HOST:PORT/MOUNT records a live stream) or RINEX observations")
@@ -494,9 +494,9 @@ void add_convert_command(CLI::App& app, ConvertArgs& args) {
 }
 
 int run_convert_command(ConvertArgs& args) {
-  canyon::app::ConvertConfig& c = args.config;
+  canyon::commands::ConvertConfig& c = args.config;
   if (!args.time.empty()) {
-    c.approx_time = canyon::app::parse_gps_calendar(args.time);
+    c.approx_time = canyon::core::parse_gps_calendar(args.time);
     if (!c.approx_time) {
       std::cerr << "canyon: error: --time must be 'YYYY-MM-DD HH:MM:SS', not '" << args.time << "'\n";
       return kExitUsage;
@@ -515,7 +515,7 @@ int run_convert_command(ConvertArgs& args) {
     std::cerr << "canyon: error: " << e << "\n";
     return kExitUsage;
   }
-  auto summary = canyon::app::run_convert(c);
+  auto summary = canyon::commands::run_convert(c);
   if (!summary) {
     std::cerr << "canyon: error: " << summary.error().to_string() << "\n";
     return kExitInput;

@@ -1,8 +1,8 @@
 // canyon-rover: the real-time rover. The rover's observations replayed from RINEX at real-time pace (or faster),
 // base corrections from a RINEX file or from the DDS RtcmFrame topic, VIO from files or from the DDS VioPose and
-// TimeSyncSample topics (app/live_vio.hpp), through the six-stage threaded
-// pipeline (app/epoch_pipeline.hpp, the same stages as canyon process); solutions and stage timing published on DDS
-// (idl/RoverPipeline.idl). `canyon rover ...` runs this executable; config/rover.yaml documents the configuration.
+// TimeSyncSample topics (pipeline/live_vio.hpp), through the six-stage threaded
+// pipeline (pipeline/epoch_pipeline.hpp, the same stages as canyon process); solutions and stage timing published on
+// DDS (idl/RoverPipeline.idl). `canyon rover ...` runs this executable; config/rover.yaml documents the configuration.
 // SIGINT/SIGTERM stop it cleanly: ingest stops, the epochs in flight are finished and published.
 // Exit codes: 0 success, 1 input or runtime failure, 2 bad command line or configuration.
 
@@ -18,19 +18,19 @@
 #include <readerwriterqueue/readerwritercircularbuffer.h>
 #include <spdlog/spdlog.h>
 
-#include "canyon/app/cpu_affinity.hpp"
-#include "canyon/app/epoch_pipeline.hpp"
-#include "canyon/app/live_vio.hpp"
-#include "canyon/app/observation_stream.hpp"
-#include "canyon/app/process.hpp"
-#include "canyon/app/rover_config.hpp"
-#include "canyon/app/rover_ingest.hpp"
+#include "canyon/commands/process.hpp"
+#include "canyon/config/rover_config.hpp"
+#include "canyon/dds/dds.hpp"
+#include "canyon/dds/rover_msgs.hpp"
+#include "canyon/dds/rtcm_frame.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/io/nmea.hpp"
 #include "canyon/io/pos_file.hpp"
-#include "canyon/pipeline/dds.hpp"
-#include "canyon/pipeline/rover_msgs.hpp"
-#include "canyon/pipeline/rtcm_frame.hpp"
+#include "canyon/pipeline/cpu_affinity.hpp"
+#include "canyon/pipeline/epoch_pipeline.hpp"
+#include "canyon/pipeline/live_vio.hpp"
+#include "canyon/pipeline/observation_stream.hpp"
+#include "canyon/pipeline/rover_ingest.hpp"
 
 #include "main_guard.hpp"
 
@@ -41,16 +41,15 @@ constexpr int kExitUsage = 2;
 
 using canyon::Result;
 using canyon::Status;
-namespace app = canyon::app;
 namespace core = canyon::core;
-namespace pl = canyon::pipeline;
+namespace pl = canyon::dds;
 
-std::atomic<app::EpochPipeline*> g_pipeline{nullptr};
+std::atomic<canyon::pipeline::EpochPipeline*> g_pipeline{nullptr};
 std::atomic<bool> g_stop{false};
 
 extern "C" void on_signal(int /*signal*/) {
   g_stop.store(true);
-  if (app::EpochPipeline* p = g_pipeline.load()) p->stop();
+  if (canyon::pipeline::EpochPipeline* p = g_pipeline.load()) p->stop();
 }
 
 /// An RTCM frame from the DDS listener to ingest.
@@ -60,8 +59,9 @@ struct BaseFrameSample {
 };
 
 /// The DDS base: the RtcmFrame samples the listener queued, into the live base cursor.
-app::BaseInput::PollFn dds_base_poll(moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& frames) {
-  return [&frames](std::int64_t timeout_us, app::LiveBaseCursor& cursor) {
+canyon::pipeline::BaseInput::PollFn dds_base_poll(
+    moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& frames) {
+  return [&frames](std::int64_t timeout_us, canyon::pipeline::LiveBaseCursor& cursor) {
     BaseFrameSample frame;
     if (!frames.wait_dequeue_timed(frame, timeout_us)) return !g_stop.load();
     cursor.push(frame.bytes, frame.send_ns);
@@ -75,7 +75,7 @@ void log_warning(const std::string& text) {
 }
 
 /// A link's events, prefixed with its role ("rover", "base").
-app::ByteLink::LogFn link_log(const std::string& role) {
+canyon::pipeline::ByteLink::LogFn link_log(const std::string& role) {
   return [role](bool problem, const std::string& text) {
     if (problem) {
       spdlog::warn("{} {}", role, text);
@@ -86,18 +86,19 @@ app::ByteLink::LogFn link_log(const std::string& role) {
 }
 
 /// The rover's input: the RINEX file (estimator.rover) or the receiver link (input.rover_source).
-Result<app::RoverInput> open_rover(const app::RoverConfig& config, const canyon::io::ObsFilter& filter) {
-  app::RoverInput input;
-  if (config.rover == app::RoverInputKind::Ubx) {
-    auto address = app::LinkAddress::parse(config.rover_source);
+Result<canyon::pipeline::RoverInput> open_rover(const canyon::config::RoverConfig& config,
+                                                const canyon::io::ObsFilter& filter) {
+  canyon::pipeline::RoverInput input;
+  if (config.rover == canyon::config::RoverInputKind::Ubx) {
+    auto address = canyon::pipeline::LinkAddress::parse(config.rover_source);
     if (!address) return address.error();
-    auto link = app::ByteLink::open(*address, config.link, link_log("rover"));
+    auto link = canyon::pipeline::ByteLink::open(*address, config.link, link_log("rover"));
     if (!link) return link.error();
-    input.receiver = std::make_unique<app::ReceiverStream>(std::move(*link), filter, log_warning);
-    input.paced = address->kind == app::LinkAddress::Kind::File;
+    input.receiver = std::make_unique<canyon::pipeline::ReceiverStream>(std::move(*link), filter, log_warning);
+    input.paced = address->kind == canyon::pipeline::LinkAddress::Kind::File;
     return input;
   }
-  auto rover = app::ObservationStream::open(config.estimator.rover_obs, filter);
+  auto rover = canyon::pipeline::ObservationStream::open(config.estimator.rover_obs, filter);
   if (!rover) return rover.error();
   input.rinex.emplace(std::move(*rover));
   return input;
@@ -106,16 +107,17 @@ Result<app::RoverInput> open_rover(const app::RoverConfig& config, const canyon:
 /// The base's input and position: the RINEX file (position from estimator.base_position or its header), or a
 /// stream (DDS frames, an NTRIP or TCP link; position from estimator.base_position, else from the stream's 1005/1006,
 /// handed to the stages with the epochs by RoverIngest).
-Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::io::ObsFilter& filter,
-                                 const std::optional<core::GpsTime>& rover_start,
-                                 moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& dds_frames,
-                                 Eigen::Vector3d& p_E_base, std::shared_ptr<app::ByteLink>& base_link) {
-  const app::ProcessConfig& est = config.estimator;
-  app::BaseInput input;
+Result<canyon::pipeline::BaseInput> open_base(
+    const canyon::config::RoverConfig& config, const canyon::io::ObsFilter& filter,
+    const std::optional<core::GpsTime>& rover_start,
+    moodycamel::BlockingReaderWriterCircularBuffer<BaseFrameSample>& dds_frames, Eigen::Vector3d& p_E_base,
+    std::shared_ptr<canyon::pipeline::ByteLink>& base_link) {
+  const canyon::config::ProcessConfig& est = config.estimator;
+  canyon::pipeline::BaseInput input;
   if (est.base_position_E_m) p_E_base = *est.base_position_E_m;
   switch (config.base) {
-    case app::RoverBaseSource::File: {
-      auto base = app::ObservationStream::open(est.base_obs, filter, rover_start);
+    case canyon::config::RoverBaseSource::File: {
+      auto base = canyon::pipeline::ObservationStream::open(est.base_obs, filter, rover_start);
       if (!base) return base.error();
       if (!est.base_position_E_m) {
         if (!base->header().receiver.approx_position_E_m) {
@@ -126,20 +128,20 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
       input.file.emplace(std::move(*base));
       return input;
     }
-    case app::RoverBaseSource::Dds:
+    case canyon::config::RoverBaseSource::Dds:
       input.poll = dds_base_poll(dds_frames);
       input.name = "base DDS " + config.rtcm_topic;
       break;
-    case app::RoverBaseSource::Ntrip:
-    case app::RoverBaseSource::Tcp: {
-      auto address = app::LinkAddress::parse(config.base_source);
+    case canyon::config::RoverBaseSource::Ntrip:
+    case canyon::config::RoverBaseSource::Tcp: {
+      auto address = canyon::pipeline::LinkAddress::parse(config.base_source);
       if (!address) return address.error();
-      app::LinkOptions options = config.link;
+      canyon::pipeline::LinkOptions options = config.link;
       options.gga_interval_s = config.ntrip_gga_interval_s;  // ntrip only (validated)
-      auto link = app::ByteLink::open(*address, options, link_log("base"));
+      auto link = canyon::pipeline::ByteLink::open(*address, options, link_log("base"));
       if (!link) return link.error();
-      std::shared_ptr<app::ByteLink> shared(std::move(*link));
-      input.poll = app::link_base_poll(shared, log_warning);
+      std::shared_ptr<canyon::pipeline::ByteLink> shared(std::move(*link));
+      input.poll = canyon::pipeline::link_base_poll(shared, log_warning);
       input.name = "base " + address->text;
       input.link = shared;
       base_link = std::move(shared);
@@ -150,18 +152,18 @@ Result<app::BaseInput> open_base(const app::RoverConfig& config, const canyon::i
 }
 
 /// VIO over DDS: the live VIO feed of the fusion engine and the two readers that fill it (the listeners only queue).
-Status open_live_vio(const app::RoverConfig& config, pl::DdsParticipant& participant,
-                     canyon::fusion::FusionEngine& engine, std::unique_ptr<app::LiveVio>& live,
+Status open_live_vio(const canyon::config::RoverConfig& config, pl::DdsParticipant& participant,
+                     canyon::fusion::FusionEngine& engine, std::unique_ptr<canyon::pipeline::LiveVio>& live,
                      std::unique_ptr<pl::VioPoseReader>& poses, std::unique_ptr<pl::TimeSyncReader>& pairs) {
-  app::LiveVioOptions options;
+  canyon::pipeline::LiveVioOptions options;
   options.wait_s = config.vio_wait_s;
   options.queue_poses = config.vio_queue_poses;
   options.vio_on_gps_time = config.estimator.fusion.vio_on_gps_time;
   options.time_sync = config.estimator.fusion.time_sync;
   options.time_sync.causal = true;
   if (const std::string e = options.validate(); !e.empty()) return canyon::Error{"input.vio dds: " + e};
-  live = std::make_unique<app::LiveVio>(engine, options, log_warning);
-  app::LiveVio* feed = live.get();
+  live = std::make_unique<canyon::pipeline::LiveVio>(engine, options, log_warning);
+  canyon::pipeline::LiveVio* feed = live.get();
   auto p = pl::VioPoseReader::create(participant, config.vio_topic, "vio_reader", [feed](canyon::msg::VioPose&& m) {
     auto pose = pl::from_msg(m);
     if (pose) {
@@ -219,7 +221,7 @@ int run(int argc, char** argv) {
   spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [canyon-rover] [%^%l%$] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
 
-  auto config = app::load_rover_config(config_file);
+  auto config = canyon::config::load_rover_config(config_file);
   if (!config) {
     spdlog::error("{}", config.error().to_string());
     return kExitUsage;
@@ -232,7 +234,7 @@ int run(int argc, char** argv) {
     config->pipeline.cpu_affinity = {};
   }
   if (print_config) {
-    std::cout << app::to_yaml(*config);
+    std::cout << canyon::config::to_yaml(*config);
     return 0;
   }
   if (const std::string e = config->validate(); !e.empty()) {
@@ -243,17 +245,17 @@ int run(int argc, char** argv) {
     spdlog::error("{}: pipeline.{}", config_file, e);
     return kExitUsage;
   }
-  const app::ProcessConfig& est = config->estimator;
-  const bool dds_base = config->base == app::RoverBaseSource::Dds;
+  const canyon::config::ProcessConfig& est = config->estimator;
+  const bool dds_base = config->base == canyon::config::RoverBaseSource::Dds;
   const auto shown = [](const std::string& link) {  // a link as messages show it (no password)
-    auto address = app::LinkAddress::parse(link);
+    auto address = canyon::pipeline::LinkAddress::parse(link);
     return address ? address->text : link;
   };
   const std::string rover_from =
-      config->rover == app::RoverInputKind::Ubx ? shown(config->rover_source) : est.rover_obs;
-  const std::string base_from = config->base == app::RoverBaseSource::File ? est.base_obs
-                                : dds_base                                 ? "DDS " + config->rtcm_topic
-                                                                           : shown(config->base_source);
+      config->rover == canyon::config::RoverInputKind::Ubx ? shown(config->rover_source) : est.rover_obs;
+  const std::string base_from = config->base == canyon::config::RoverBaseSource::File ? est.base_obs
+                                : dds_base                                            ? "DDS " + config->rtcm_topic
+                                                                                      : shown(config->base_source);
 
   // DDS first: profiles before any participant.
   if (auto s = pl::load_profiles_or_default(config->profiles); !s.ok()) {
@@ -284,7 +286,7 @@ int run(int argc, char** argv) {
     }
     prior_writer = std::move(*p);
     float_writer = std::move(*f);
-    if (est.mode == app::ProcessMode::Fusion) {
+    if (est.mode == canyon::config::ProcessMode::Fusion) {
       auto b = pl::BridgedWriter::create(**participant, "canyon/bridged", "stage_writer");
       auto a = pl::AlignmentWriter::create(**participant, "canyon/alignment", "stage_writer");
       if (!b || !a) {
@@ -322,16 +324,16 @@ int run(int argc, char** argv) {
   }
 
   // The estimator, as canyon process builds it.
-  app::ProcessSummary notes;
+  canyon::commands::ProcessSummary notes;
   // No navigation file: the ephemerides come from the streams only (RoverConfig::validate checks they can).
   auto nav = est.nav.empty() ? Result<core::NavigationData>(core::NavigationData{})
-                             : app::load_navigation(est.nav, notes.warnings);
+                             : canyon::commands::load_navigation(est.nav, notes.warnings);
   if (!nav) {
     spdlog::error("{}", nav.error().to_string());
     return kExitRuntime;
   }
   canyon::gnss::EphemerisStore ephemerides(std::move(*nav));  // grows by the streams' ephemerides (EphemerisFeed)
-  const canyon::io::ObsFilter filter = app::process_observation_filter(est);
+  const canyon::io::ObsFilter filter = canyon::commands::process_observation_filter(est);
   auto rover = open_rover(*config, filter);
   if (!rover) {
     spdlog::error("{}", rover.error().to_string());
@@ -340,7 +342,7 @@ int run(int argc, char** argv) {
   const std::optional<core::GpsTime> rover_start =
       rover->rinex ? rover->rinex->header().first_obs : std::optional<core::GpsTime>{};
   Eigen::Vector3d p_E_base = Eigen::Vector3d::Zero();
-  std::shared_ptr<app::ByteLink> base_link;  // ntrip, tcp: the link (the rover's position goes up as GGA)
+  std::shared_ptr<canyon::pipeline::ByteLink> base_link;  // ntrip, tcp: the link (the rover's position goes up as GGA)
   auto base = open_base(*config, filter, rover_start, base_frames, p_E_base, base_link);
   if (!base) {
     spdlog::error("{}: {}", config_file, base.error().to_string());
@@ -348,13 +350,13 @@ int run(int argc, char** argv) {
   }
   std::unique_ptr<canyon::rtk::RtkEngine> rtk_engine;
   std::unique_ptr<canyon::fusion::FusionEngine> fusion_engine;
-  std::unique_ptr<app::EpochEstimator> estimator;
-  std::unique_ptr<app::LiveVio> live_vio;
+  std::unique_ptr<canyon::pipeline::EpochEstimator> estimator;
+  std::unique_ptr<canyon::pipeline::LiveVio> live_vio;
   std::unique_ptr<pl::VioPoseReader> vio_reader;
   std::unique_ptr<pl::TimeSyncReader> timesync_reader;
-  if (est.mode == app::ProcessMode::Fusion) {
+  if (est.mode == canyon::config::ProcessMode::Fusion) {
     auto track = config->vio_dds ? Result<canyon::fusion::VioTrack>(canyon::fusion::VioTrack::streaming(est.fusion.vio))
-                                 : app::load_vio_track(est, notes);
+                                 : canyon::commands::load_vio_track(est, notes);
     if (!track) {
       spdlog::error("{}", track.error().to_string());
       return kExitRuntime;
@@ -368,18 +370,19 @@ int run(int argc, char** argv) {
         return kExitRuntime;
       }
     }
-    estimator = std::make_unique<app::FusionEstimator>(*fusion_engine, live_vio.get());
+    estimator = std::make_unique<canyon::pipeline::FusionEstimator>(*fusion_engine, live_vio.get());
   } else {
     rtk_engine = std::make_unique<canyon::rtk::RtkEngine>(est.rtk_engine_options(), ephemerides, p_E_base);
-    estimator = std::make_unique<app::RtkEstimator>(*rtk_engine);
+    estimator = std::make_unique<canyon::pipeline::RtkEstimator>(*rtk_engine);
   }
-  app::EphemerisFeed feed(*estimator, ephemerides);
+  canyon::pipeline::EphemerisFeed feed(*estimator, ephemerides);
   for (const std::string& w : notes.warnings) spdlog::warn("{}", w);
   for (const std::string& r : notes.report) spdlog::info("{}", r);
 
   std::optional<canyon::io::PosWriter> pos;
   if (!est.out.empty()) {
-    auto p = canyon::io::PosWriter::create(est.out, {est.coordinates, est.time_format, app::pos_header_lines(est)});
+    auto p = canyon::io::PosWriter::create(est.out,
+                                           {est.coordinates, est.time_format, canyon::commands::pos_header_lines(est)});
     if (!p) {
       spdlog::error("{}", p.error().to_string());
       return kExitRuntime;
@@ -387,16 +390,16 @@ int run(int argc, char** argv) {
     pos = std::move(*p);
   }
 
-  app::RoverIngestOptions ingest_options;
+  canyon::pipeline::RoverIngestOptions ingest_options;
   ingest_options.pace = config->pace;
   ingest_options.base_wait_s = config->base_wait_s;
   ingest_options.stream_ephemerides = config->stream_ephemerides;
   ingest_options.base_position_from_stream = config->streamed_base() && !est.base_position_E_m;
-  app::RoverIngest source(
+  canyon::pipeline::RoverIngest source(
       std::move(*rover), std::move(*base), ingest_options, [] { return g_stop.load(); }, log_warning);
   std::uint64_t solved = 0, fixed = 0, epochs = 0;
   std::atomic<std::uint64_t> refused{0};  // the time bridge's and the ambiguity stage's threads publish
-  const auto sink = [&](const app::EpochItem& item) -> Status {
+  const auto sink = [&](const canyon::pipeline::EpochItem& item) -> Status {
     ++epochs;
     if (item.output) {
       ++solved;
@@ -408,7 +411,7 @@ int run(int argc, char** argv) {
     }
     return canyon::Ok{};
   };
-  app::EpochPipeline* pipeline_ptr = nullptr;
+  canyon::pipeline::EpochPipeline* pipeline_ptr = nullptr;
   pl::EpochContext context;
   context.rover_id = config->rover_id;
   // The solution is written as soon as the ambiguity stage has it. The stage outputs (canyon/bridged, /prior,
@@ -425,13 +428,13 @@ int run(int argc, char** argv) {
     if (pending && !writer->write(*pending)) ++refused;
     pending.reset();
   };
-  app::StageObserver observer;
-  observer.taken = [&](app::Stage stage, const app::EpochItem& item) {
-    if (stage != app::Stage::Ambiguity) return;
+  canyon::pipeline::StageObserver observer;
+  observer.taken = [&](canyon::pipeline::Stage stage, const canyon::pipeline::EpochItem& item) {
+    if (stage != canyon::pipeline::Stage::Ambiguity) return;
     context.base_late = source.base_late();
     context.malformed_samples = pl::malformed_payloads();
     if (live_vio) {
-      const app::LiveVioCounts vio = live_vio->counts();
+      const canyon::pipeline::LiveVioCounts vio = live_vio->counts();
       context.vio_dropped = vio.dropped;
       context.vio_late = vio.late_epochs;
     }
@@ -455,15 +458,15 @@ int run(int argc, char** argv) {
     if (bridged_writer) bridged_pending = pl::to_msg_bridged(item);
     if (alignment_writer) alignment_pending = pl::to_msg_alignment(item);
   };
-  observer.handed_on = [&](app::Stage stage) {
-    if (stage != app::Stage::Ambiguity) return;
+  observer.handed_on = [&](canyon::pipeline::Stage stage) {
+    if (stage != canyon::pipeline::Stage::Ambiguity) return;
     write(*timing_writer, timing_pending);
     write(bridged_writer, bridged_pending);
     write(prior_writer, prior_pending);
     write(float_writer, float_pending);
     write(alignment_writer, alignment_pending);
   };
-  app::EpochPipeline pipeline(source, feed, sink, config->pipeline, observer);
+  canyon::pipeline::EpochPipeline pipeline(source, feed, sink, config->pipeline, observer);
   pipeline_ptr = &pipeline;
   g_pipeline.store(&pipeline);
   std::signal(SIGINT, on_signal);
@@ -483,14 +486,15 @@ int run(int argc, char** argv) {
   }
   spdlog::info(
       "rover '{}': {} mode, rover from {}, base from {}, {} pipeline, pace {}; publishing {} and {} on domain {}",
-      config->rover_id, app::mode_name(est.mode), rover_from,
+      config->rover_id, canyon::config::mode_name(est.mode), rover_from,
       base_from + (config->vio_dds ? ", VIO from DDS " + config->vio_topic + " and " + config->timesync_topic : ""),
       config->pipeline.threaded ? "threaded" : "sequential", config->pace, config->solution_topic, config->timing_topic,
       config->domain);
-  for (std::size_t s = 0; s < app::kNumStages; ++s) {
+  for (std::size_t s = 0; s < canyon::pipeline::kNumStages; ++s) {
     const std::vector<int>& cpus = config->pipeline.cpu_affinity[s];
     if (!cpus.empty()) {
-      spdlog::info("{} stage thread on CPU {}", app::stage_name(static_cast<app::Stage>(s)), app::cpu_list_text(cpus));
+      spdlog::info("{} stage thread on CPU {}", canyon::pipeline::stage_name(static_cast<canyon::pipeline::Stage>(s)),
+                   canyon::pipeline::cpu_list_text(cpus));
     }
   }
   const auto start = std::chrono::steady_clock::now();
@@ -508,7 +512,7 @@ int run(int argc, char** argv) {
     spdlog::warn("base: {} RTCM frames dropped (queue full), {} malformed", base_frames_dropped.load(),
                  base_frames_bad.load());
   }
-  for (const app::RoverIngest::Summary& s : source.summary()) {
+  for (const canyon::pipeline::RoverIngest::Summary& s : source.summary()) {
     if (s.problems) {
       spdlog::warn("{}", s.text);
     } else {
@@ -535,7 +539,7 @@ int run(int argc, char** argv) {
                  feed.added());
   }
   if (live_vio) {
-    const app::LiveVioCounts c = live_vio->counts();
+    const canyon::pipeline::LiveVioCounts c = live_vio->counts();
     const bool problems = c.dropped > 0 || c.unmapped > 0 || c.out_of_order > 0 || c.late_epochs > 0;
     spdlog::log(problems ? spdlog::level::warn : spdlog::level::info,
                 "VIO over DDS: {} poses and {} time-sync pairs received, {} poses used; {} dropped (queue full), {} "
@@ -545,14 +549,15 @@ int run(int argc, char** argv) {
   if (fusion_engine) {
     for (const std::string& line : fusion_engine->report()) spdlog::info("{}", line);
   }
-  const app::PipelineStats stats = pipeline.stats();
+  const canyon::pipeline::PipelineStats stats = pipeline.stats();
   std::uint64_t waits = 0;
   std::string by_producer;  // each queue's waits, named by the stage that fills it
   for (std::size_t i = 0; i < stats.full_waits.size(); ++i) {
     waits += stats.full_waits[i];
     if (stats.full_waits[i] == 0) continue;
-    by_producer += (by_producer.empty() ? " (" : ", ") + std::string(app::stage_name(static_cast<app::Stage>(i))) +
-                   " " + std::to_string(stats.full_waits[i]);
+    by_producer += (by_producer.empty() ? " (" : ", ") +
+                   std::string(canyon::pipeline::stage_name(static_cast<canyon::pipeline::Stage>(i))) + " " +
+                   std::to_string(stats.full_waits[i]);
   }
   if (!by_producer.empty()) by_producer += ")";
   spdlog::info("{} epochs, {} solved, {} fixed in {:.3f} s ({:.0f} epochs/s); queue-full waits {}{}{}", epochs, solved,

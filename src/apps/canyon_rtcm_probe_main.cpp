@@ -30,9 +30,9 @@
 #include <CLI/CLI.hpp>
 
 #include "canyon/core/time.hpp"
+#include "canyon/dds/dds.hpp"
+#include "canyon/dds/rtcm_frame.hpp"
 #include "canyon/io/rtcm3.hpp"
-#include "canyon/pipeline/dds.hpp"
-#include "canyon/pipeline/rtcm_frame.hpp"
 
 #include "main_guard.hpp"
 
@@ -101,8 +101,8 @@ double json_number(const std::string& text, const std::string& key) {
   return std::strtod(text.c_str() + at + key.size() + 3, nullptr);
 }
 
-int inject(canyon::pipeline::DdsParticipant& participant, const std::string& topic, int count, double wait_s) {
-  auto writer = canyon::pipeline::RtcmWriter::create(participant, topic, "rtcm_writer");
+int inject(canyon::dds::DdsParticipant& participant, const std::string& topic, int count, double wait_s) {
+  auto writer = canyon::dds::RtcmWriter::create(participant, topic, "rtcm_writer");
   if (!writer) {
     std::cout << "{\"writer\":false,\"error\":\"" << writer.error().message << "\"}\n";
     return kExitRefused;
@@ -118,13 +118,13 @@ int inject(canyon::pipeline::DdsParticipant& participant, const std::string& top
     payload[0] = static_cast<std::uint8_t>(1005 >> 4);  // a 1005 of station 4095
     payload[1] = static_cast<std::uint8_t>(((1005 & 0xF) << 4) | 0x0F);
     payload[2] = 0xFF;
-    canyon::app::BaseFrame f;
+    canyon::base::BaseFrame f;
     f.sequence = static_cast<std::uint64_t>(i);
     f.message_number = 1005;
     f.station_id = 4095;
     f.bytes = *canyon::io::rtcm3::frame_rtcm3(payload);
     f.receive_ns = canyon::core::pipeline_now_ns();
-    if (canyon::pipeline::publish_rtcm_frame(**writer, f)) ++written;
+    if (canyon::dds::publish_rtcm_frame(**writer, f)) ++written;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   (*writer)->wait_for_acknowledgments(2.0);
@@ -168,7 +168,7 @@ int run(int argc, char** argv) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : kExitUsage;
   }
-  if (auto s = canyon::pipeline::load_profiles_or_default(profiles); !s.ok()) {
+  if (auto s = canyon::dds::load_profiles_or_default(profiles); !s.ok()) {
     std::cerr << "canyon-rtcm-probe: " << s.error().to_string() << "\n";
     return kExitUsage;
   }
@@ -176,7 +176,7 @@ int run(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
 
   if (mode == "inject") {
-    auto p = canyon::pipeline::DdsParticipant::create(domain);
+    auto p = canyon::dds::DdsParticipant::create(domain);
     if (!p) {
       std::cout << "{\"participant\":false,\"error\":\"" << p.error().message << "\"}\n";
       return kExitRefused;
@@ -198,18 +198,18 @@ int run(int argc, char** argv) {
   std::mutex mutex;
   std::vector<ReaderStats> stats(static_cast<std::size_t>(readers));
   std::atomic<std::int64_t> last_frame_ns{0};
-  std::vector<std::unique_ptr<canyon::pipeline::DdsParticipant>> participants;
-  std::vector<std::unique_ptr<canyon::pipeline::RtcmReader>> dds_readers;
+  std::vector<std::unique_ptr<canyon::dds::DdsParticipant>> participants;
+  std::vector<std::unique_ptr<canyon::dds::RtcmReader>> dds_readers;
   for (int k = 0; k < readers; ++k) {
-    auto p = canyon::pipeline::DdsParticipant::create(domain);
+    auto p = canyon::dds::DdsParticipant::create(domain);
     if (!p) {
       std::cerr << "canyon-rtcm-probe: " << p.error().to_string() << "\n";
       return kExitRuntime;
     }
-    auto r = canyon::pipeline::RtcmReader::create(**p, topic, "rtcm_reader", [&, k](canyon::msg::RtcmFrame&& m) {
+    auto r = canyon::dds::RtcmReader::create(**p, topic, "rtcm_reader", [&, k](canyon::msg::RtcmFrame&& m) {
       const std::int64_t now = unix_now_ns();
       last_frame_ns.store(canyon::core::pipeline_now_ns());
-      auto f = canyon::pipeline::from_msg(m);
+      auto f = canyon::dds::from_msg(m);
       const std::lock_guard lock(mutex);
       ReaderStats& s = stats[static_cast<std::size_t>(k)];
       if (!f) {

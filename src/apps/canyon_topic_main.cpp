@@ -8,7 +8,7 @@
 //     every value with 17 significant digits, so the replay carries the same numbers).
 //   echo TOPIC: one line per sample.
 //   monitor: per-stage and end-to-end latency percentiles, correction age, queues, drops and the solution, refreshed
-//     in the terminal or as JSON lines (--json; schema in app/monitor_model.hpp).
+//     in the terminal or as JSON lines (--json; schema in pipeline/monitor_model.hpp).
 // All of them stop on SIGINT/SIGTERM, after --count samples, after --duration seconds, or once the publishers they
 // matched are all gone (--until-gone, on by default for record and monitor).
 // Exit codes: 0 success, 1 runtime failure, 2 bad command line.
@@ -26,13 +26,13 @@
 
 #include <CLI/CLI.hpp>
 
-#include "canyon/app/monitor_model.hpp"
+#include "canyon/dds/dds.hpp"
+#include "canyon/dds/rover_msgs.hpp"
+#include "canyon/dds/rtcm_frame.hpp"
 #include "canyon/io/nmea.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/io/vio_file.hpp"
-#include "canyon/pipeline/dds.hpp"
-#include "canyon/pipeline/rover_msgs.hpp"
-#include "canyon/pipeline/rtcm_frame.hpp"
+#include "canyon/pipeline/monitor_model.hpp"
 
 #include "main_guard.hpp"
 #ifdef CANYON_WITH_DASHBOARD
@@ -46,8 +46,7 @@ constexpr int kExitUsage = 2;
 // "record", "echo" or "monitor": set once in main from the name the executable runs under, before anything reads it.
 std::string g_tool;
 
-namespace pl = canyon::pipeline;
-namespace app = canyon::app;
+namespace pl = canyon::dds;
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int /*signal*/) {
@@ -95,7 +94,7 @@ int run(int argc, char** argv) {
   } else {
     cli.add_option("--solution-topic", solution_topic, "Solution topic");
     cli.add_option("--timing-topic", timing_topic, "Stage timing topic");
-    cli.add_flag("--json", json, "One JSON object per line (schema: include/canyon/app/monitor_model.hpp)");
+    cli.add_flag("--json", json, "One JSON object per line (schema: include/canyon/pipeline/monitor_model.hpp)");
     cli.add_option("--interval", interval_s, "Refresh period (s)")->check(CLI::Range(0.05, 3600.0));
 #ifdef CANYON_WITH_DASHBOARD
     cli.add_option("--http", http_port, "Also serve the live dashboard (web page, /events, /metrics) on this port")
@@ -188,7 +187,7 @@ int run(int argc, char** argv) {
   }
   std::int64_t bad = 0;
   const auto monitor_start = canyon::core::pipeline_now_ns();
-  app::MonitorModel model(monitor_start);
+  canyon::pipeline::MonitorModel model(monitor_start);
 
   std::unique_ptr<pl::SolutionReader> solution_reader;
   std::unique_ptr<pl::TimingReader> timing_reader;

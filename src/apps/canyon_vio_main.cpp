@@ -16,9 +16,9 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "canyon/dds/dds.hpp"
+#include "canyon/dds/rover_msgs.hpp"
 #include "canyon/io/vio_file.hpp"
-#include "canyon/pipeline/dds.hpp"
-#include "canyon/pipeline/rover_msgs.hpp"
 
 #include "main_guard.hpp"
 
@@ -28,7 +28,7 @@ constexpr int kExitRuntime = 1;
 constexpr int kExitUsage = 2;
 constexpr int kAckEvery = 256;  // pace 0: wait for the readers' acknowledgements after this many samples
 
-namespace pl = canyon::pipeline;
+namespace pl = canyon::dds;
 namespace io = canyon::io;
 
 std::atomic<bool> g_stop{false};

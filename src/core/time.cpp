@@ -241,4 +241,22 @@ std::string format_calendar(const CalendarTime& c, int decimals) {
   return buffer;
 }
 
+std::optional<GpsTime> parse_gps_calendar(const std::string& text) {
+  CalendarTime c;
+  char sep1 = 0;
+  char sep2 = 0;
+  char tail = 0;
+  const int n = std::sscanf(text.c_str(), "%d%c%d%c%d %d:%d:%lf%c", &c.year, &sep1, &c.month, &sep2, &c.day, &c.hour,
+                            &c.minute, &c.second, &tail);
+  if (n == 5) {
+    c.hour = 0;
+    c.minute = 0;
+    c.second = 0.0;
+  } else if (n != 8) {
+    return std::nullopt;
+  }
+  if ((sep1 != '-' && sep1 != '/') || sep2 != sep1 || !is_valid(c)) return std::nullopt;
+  return calendar_to_gps(c);
+}
+
 }  // namespace canyon::core

@@ -1,5 +1,5 @@
-# Proves that the estimation core (modules 1-6: core io gnss rtk fusion sim eval), the network module (net) and the
-# batch application layer (app) use no DDS middleware:
+# Proves that every module but dds (core io net gnss rtk fusion sim eval pipeline config commands base netemu dashboard)
+# uses no DDS middleware:
 #  1. no library canyon_<module> links fastrtps, fastcdr, foonathan_memory or canyon_msgs, directly or
 #     transitively (LINK_FILE: closures written at configure time by tests/build/NoDds.cmake);
 #  2. no header under include/canyon/<module>/ and no source under src/<module>/ includes a Fast DDS / Fast CDR
@@ -11,7 +11,7 @@ foreach(var LINK_FILE SOURCE_DIR)
   endif()
 endforeach()
 
-set(core_modules core io net gnss rtk fusion sim eval app)
+set(core_modules core io net gnss rtk fusion sim eval pipeline config commands base netemu dashboard)
 set(failures)
 
 # 1. Link closures.

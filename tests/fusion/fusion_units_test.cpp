@@ -17,8 +17,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "canyon/app/process_config.hpp"
-#include "canyon/app/scenario_config.hpp"
+#include "canyon/config/process_config.hpp"
+#include "canyon/config/scenario_config.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
 #include "canyon/fusion/alignment.hpp"
@@ -449,7 +449,7 @@ struct Simulated {
 std::optional<Simulated> simulate_scenario(const std::string& name, double duration_s, const std::string& tag,
                                            const sim::SimulationOptions& options = {},
                                            std::optional<std::uint64_t> seed = std::nullopt) {
-  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios" / (name + ".yaml")).string());
+  auto scenario = config::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios" / (name + ".yaml")).string());
   if (!scenario) {
     ADD_FAILURE() << scenario.error().to_string();
     return std::nullopt;
@@ -634,9 +634,9 @@ struct FusionRun {
   FusionStats stats;
 };
 FusionRun run_fusion(const sim::Simulation& sim, const core::GpsTime& start,
-                     const std::function<void(app::ProcessConfig&)>& change) {
+                     const std::function<void(config::ProcessConfig&)>& change) {
   FusionRun run;
-  auto config = app::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/fusion.yaml").string());
+  auto config = config::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/fusion.yaml").string());
   if (!config) {
     ADD_FAILURE() << config.error().to_string();
     return run;
@@ -673,17 +673,17 @@ struct Comparison {
 /// The shipped `scenario` (seed, duration) fused with config/fusion.yaml as it is and changed by `turn_off`.
 std::optional<Comparison> with_and_without(const std::string& scenario, std::uint64_t seed, double duration_s,
                                            const std::string& tag,
-                                           const std::function<void(app::ProcessConfig&)>& turn_off) {
+                                           const std::function<void(config::ProcessConfig&)>& turn_off) {
   auto simulated = simulate_scenario(scenario, duration_s, tag, {}, seed);
   if (!simulated) return std::nullopt;
   const core::GpsTime start = simulated->scenario.start;
-  return Comparison{run_fusion(simulated->sim, start, [](app::ProcessConfig&) {}),
+  return Comparison{run_fusion(simulated->sim, start, [](config::ProcessConfig&) {}),
                     run_fusion(simulated->sim, start, turn_off)};
 }
 std::optional<Comparison> with_and_without(std::uint64_t seed, double duration_s, const std::string& tag,
                                            const std::function<void(FusionOptions&)>& turn_off) {
   return with_and_without("urban-severe", seed, duration_s, tag,
-                          [&turn_off](app::ProcessConfig& config) { turn_off(config.fusion); });
+                          [&turn_off](config::ProcessConfig& config) { turn_off(config.fusion); });
 }
 
 TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCanyon) {
@@ -739,7 +739,7 @@ TEST(FusionHeadingFreeTest, AStartInTheCanyonHasASolutionAtEveryEpoch) {
 
 // --- Float consistency (rtk::RtkOptions::float_consistency_level) ------------------------------------------------
 
-void no_consistency_test(app::ProcessConfig& config) {
+void no_consistency_test(config::ProcessConfig& config) {
   config.rtk.float_consistency_level = 0.0;
 }
 
@@ -768,7 +768,7 @@ TEST(FloatConsistencyTest, CanyonRtkTakesNoWrongFixesInAMidRiseCanyon) {
   auto simulated = simulate_scenario("urban-moderate", 600.0, "consistency-rtk", {}, 9);
   ASSERT_TRUE(simulated);
   const sim::Simulation& sim = simulated->sim;
-  auto config = app::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/rtk-urban.yaml").string());
+  auto config = config::load_process_config((fs::path(CANYON_SOURCE_DIR) / "config/rtk-urban.yaml").string());
   ASSERT_TRUE(config) << config.error().to_string();
   const gnss::EphemerisStore eph(sim.nav);
   const auto wrong_fixes = [&](double level, int& fixed, int& inconsistent) {
@@ -814,7 +814,7 @@ TEST(FloatConsistencyTest, OpenSkyFixesAreUnchanged) {
 
 // --- Ambiguity random walk (config/fusion.yaml: rtk.ambiguity_noise_cyc 0.01) -------------------------------------
 
-void ambiguity_walk_of_rtk_yaml(app::ProcessConfig& config) {
+void ambiguity_walk_of_rtk_yaml(config::ProcessConfig& config) {
   config.rtk.ambiguity_noise_cyc = rtk::RtkOptions{}.ambiguity_noise_cyc;  // rtk.yaml's value: the default
 }
 

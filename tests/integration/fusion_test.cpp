@@ -16,7 +16,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "canyon/app/scenario_config.hpp"
+#include "canyon/config/scenario_config.hpp"
 #include "canyon/fusion/alignment.hpp"
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/gnss/ephemeris.hpp"
@@ -62,7 +62,7 @@ struct CalibrationResult {
 };
 
 CalibrationResult calibrate_square_walk(double length_m, const Eigen::Vector3d& t_IA) {
-  auto scenario = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/open-sky.yaml").string());
+  auto scenario = config::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/open-sky.yaml").string());
   EXPECT_TRUE(scenario.ok());
   const double side = length_m / 4.0;
   scenario->route.waypoints_N_m = {{0.0, 0.0}, {side, 0.0}, {side, side}, {0.0, side}, {0.0, 0.0}};

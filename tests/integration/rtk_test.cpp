@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "canyon/app/process.hpp"
+#include "canyon/commands/process.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
 #include "canyon/eval/metrics.hpp"
@@ -36,15 +36,15 @@ Eigen::Vector3d llh_deg(double lat, double lon, double h) {
 }
 
 struct RtkRun {
-  app::ProcessSummary summary;
+  commands::ProcessSummary summary;
   std::vector<core::Solution> solutions;
 };
 
 std::optional<RtkRun> run_rtk(const std::string& name, const std::string& rover, const std::string& base,
                               const std::vector<std::string>& nav, const Eigen::Vector3d& p_E_base,
-                              const std::function<void(app::ProcessConfig&)>& adjust = {}) {
-  app::ProcessConfig c;
-  c.mode = app::ProcessMode::Rtk;
+                              const std::function<void(config::ProcessConfig&)>& adjust = {}) {
+  config::ProcessConfig c;
+  c.mode = config::ProcessMode::Rtk;
   c.rover_obs = (shared_data() / rover).string();
   c.base_obs = (shared_data() / base).string();
   for (const auto& n : nav) c.nav.push_back((shared_data() / n).string());
@@ -53,7 +53,7 @@ std::optional<RtkRun> run_rtk(const std::string& name, const std::string& rover,
   const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   c.out = (test::temp_dir("rtk_" + test_name) / (name + ".pos")).string();
   if (adjust) adjust(c);
-  auto summary = app::run_process(c);
+  auto summary = commands::run_process(c);
   EXPECT_TRUE(summary.ok()) << summary.error().to_string();
   if (!summary) return std::nullopt;
   auto sols = io::read_pos_file(c.out);
@@ -86,7 +86,7 @@ TEST(RtkRealData, CssrlibStaticEveryEpochFixedWithinOneCentimetre) {
   const Eigen::Vector3d truth(-3962108.673, 3381309.574, 3668678.638);
   for (const auto mode : {rtk::ArMode::Continuous, rtk::ArMode::Instantaneous}) {
     auto run = run_rtk("cssrlib_static", "cssrlib-static-doy078/SEPT078M1.21O", "cssrlib-static-doy078/3034078M1.21O",
-                       {"cssrlib-static-doy078/SEPT078M.21P"}, base, [&](app::ProcessConfig& c) {
+                       {"cssrlib-static-doy078/SEPT078M.21P"}, base, [&](config::ProcessConfig& c) {
                          c.rtk.ar_mode = mode;
                          c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                        });
@@ -101,7 +101,7 @@ TEST(RtkRealData, MatrtklibStaticEveryEpochFixedWithinOneCentimetre) {
   const Eigen::Vector3d truth = llh_deg(35.13469901, 136.97757549, 104.8626);
   for (const auto mode : {rtk::ArMode::Continuous, rtk::ArMode::Instantaneous, rtk::ArMode::FixAndHold}) {
     auto run = run_rtk("matrtklib", "matrtklib-static/rover.obs", "matrtklib-static/base.obs",
-                       {"matrtklib-static/base.nav"}, base, [&](app::ProcessConfig& c) { c.rtk.ar_mode = mode; });
+                       {"matrtklib-static/base.nav"}, base, [&](config::ProcessConfig& c) { c.rtk.ar_mode = mode; });
     ASSERT_TRUE(run.has_value());
     expect_static_fixed(*run, truth, std::string("matrtklib ") + rtk::ar_mode_name(mode));
   }
@@ -116,17 +116,17 @@ TEST(RtkRealData, GlonassArOnIdenticalReceiversAndWarningOtherwise) {
   const Eigen::Vector3d base = llh_deg(35.134707705, 136.977577939, 104.853);
   const Eigen::Vector3d truth = llh_deg(35.13469901, 136.97757549, 104.8626);
   auto same = run_rtk("matrtklib-glonass", "matrtklib-static/rover.obs", "matrtklib-static/base.obs",
-                      {"matrtklib-static/base.nav"}, base, [&](app::ProcessConfig& c) { c.rtk.glonass_ar = true; });
+                      {"matrtklib-static/base.nav"}, base, [&](config::ProcessConfig& c) { c.rtk.glonass_ar = true; });
   ASSERT_TRUE(same.has_value());
   expect_static_fixed(*same, truth, "matrtklib glonass_ar on");
-  const auto warns_glonass = [](const app::ProcessSummary& s) {
+  const auto warns_glonass = [](const commands::ProcessSummary& s) {
     return std::any_of(s.warnings.begin(), s.warnings.end(),
                        [](const std::string& w) { return w.find("glonass_ar is on") != std::string::npos; });
   };
   EXPECT_FALSE(warns_glonass(same->summary));
   auto mixed = run_rtk("cssrlib-glonass", "cssrlib-static-doy078/SEPT078M1.21O", "cssrlib-static-doy078/3034078M1.21O",
                        {"cssrlib-static-doy078/SEPT078M.21P"}, Eigen::Vector3d(-3959400.631, 3385704.533, 3667523.111),
-                       [&](app::ProcessConfig& c) { c.rtk.glonass_ar = true; });
+                       [&](config::ProcessConfig& c) { c.rtk.glonass_ar = true; });
   ASSERT_TRUE(mixed.has_value());
   EXPECT_TRUE(warns_glonass(mixed->summary));
 }
@@ -152,7 +152,7 @@ TEST(RtkSimulator, InstinctBothVariantsBothRoversFixedWithinOneCentimetre) {
     auto run =
         run_rtk("instinct", dir + "Rover-" + k.rover + "_MO_Spirent.obs", dir + "Base-static_MO_Spirent.obs",
                 {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
-                base, [&](app::ProcessConfig& c) {
+                base, [&](config::ProcessConfig& c) {
                   c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                   c.rtk.troposphere_saastamoinen = k.atmosphere;  // the simulation's own models
                   c.spp.troposphere_saastamoinen = c.spp.ionosphere_klobuchar = k.atmosphere;
@@ -183,7 +183,7 @@ TEST(RtkSimulator, InstinctDynamicRoverWithTheConstantAccelerationModel) {
   const std::string dir = "instinct-spirent-rtk-sim/iono-Klob_tropo-Saast/";
   auto run = run_rtk("instinct_dynamics", dir + "Rover-dynamic_MO_Spirent.obs", dir + "Base-static_MO_Spirent.obs",
                      {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
-                     base, [](app::ProcessConfig& c) {
+                     base, [](config::ProcessConfig& c) {
                        c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                        c.rtk.dynamics = true;
                      });
@@ -212,7 +212,7 @@ TEST(RtkSimulator, ExcludedSatellitesNeverReachTheSinglePointPrior) {
         run_rtk("gps_excluded_" + std::to_string(excluded), dir + "Rover-dynamic_MO_Spirent.obs",
                 dir + "Base-static_MO_Spirent.obs",
                 {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
-                base, [excluded](app::ProcessConfig& c) {
+                base, [excluded](config::ProcessConfig& c) {
                   c.spp.use_glonass = c.spp.use_galileo = c.spp.use_beidou = c.spp.use_qzss = false;
                   c.rtk.observables.use_glonass = c.rtk.observables.use_galileo = false;
                   c.rtk.observables.use_beidou = c.rtk.observables.use_qzss = false;
@@ -242,7 +242,7 @@ TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
   for (const Case& k : {Case{rtk::ArMode::Continuous, "rtk_kinematic.pos"},
                         Case{rtk::ArMode::Instantaneous, "rtk_kinematic_inst.pos"}}) {
     auto run = run_rtk("kinematic", "cssrlib-kinematic-doy265/SEPT265G.21O", "cssrlib-kinematic-doy265/3034265G.21O",
-                       {"cssrlib-kinematic-doy265/SEPT2650.21P"}, base, [&](app::ProcessConfig& c) {
+                       {"cssrlib-kinematic-doy265/SEPT2650.21P"}, base, [&](config::ProcessConfig& c) {
                          c.rtk.ar_mode = k.mode;
                          c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                          c.rtk.observables.use_qzss = false;  // RTKLIB's reference runs are GPS + Galileo
@@ -328,7 +328,7 @@ TEST(RtkRealData, CssrlibKinematicWithQzssAndOnL1Alone) {
         Case{"continuous L1", rtk::ArMode::Continuous, false, 1, nullptr, 0.9},
         Case{"instantaneous L1", rtk::ArMode::Instantaneous, false, 1, nullptr, 0.0}}) {
     auto run = run_rtk("kinematic", "cssrlib-kinematic-doy265/SEPT265G.21O", "cssrlib-kinematic-doy265/3034265G.21O",
-                       {"cssrlib-kinematic-doy265/SEPT2650.21P"}, base, [&](app::ProcessConfig& c) {
+                       {"cssrlib-kinematic-doy265/SEPT2650.21P"}, base, [&](config::ProcessConfig& c) {
                          c.rtk.ar_mode = k.mode;
                          c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                          c.rtk.observables.use_qzss = k.qzss;
@@ -364,7 +364,7 @@ TEST(RtkRealData, M8pSingleFrequencyFixRateAtLeastRtklibs) {
   ASSERT_TRUE(base_header->header().receiver.approx_position_E_m.has_value());
   auto run = run_rtk("m8p", dir + "20181004_rover-20181004-1532.obs", dir + "20181004_base-20181004-1452.obs",
                      {dir + "20181004_base-20181004-1452.nav"}, *base_header->header().receiver.approx_position_E_m,
-                     [](app::ProcessConfig& c) {
+                     [](config::ProcessConfig& c) {
                        c.rtk.observables.num_frequencies = 1;
                        c.rtk.observables.use_galileo = c.rtk.observables.use_beidou = false;
                        c.rtk.observables.use_qzss = false;  // RTKLIB's run: navsys 5 (GPS + GLONASS)
@@ -400,8 +400,8 @@ TEST(RtkBadInput, MissingBasePositionAndBaseFromAnotherDay) {
   for (const auto& s : run->solutions) EXPECT_EQ(s.status, core::SolutionStatus::Single);
 
   // A base file without APPROX POSITION and no configured position: a clear error naming the base file.
-  app::ProcessConfig c;
-  c.mode = app::ProcessMode::Rtk;
+  config::ProcessConfig c;
+  c.mode = config::ProcessMode::Rtk;
   c.rover_obs = (shared_data() / "cssrlib-static-doy078/SEPT078M1.21O").string();
   const fs::path no_pos = test::temp_dir("rtk") / "base_without_position.obs";
   {
@@ -415,7 +415,7 @@ TEST(RtkBadInput, MissingBasePositionAndBaseFromAnotherDay) {
   c.base_obs = no_pos.string();
   c.nav = {(shared_data() / "cssrlib-static-doy078/SEPT078M.21P").string()};
   c.out = (test::temp_dir("rtk") / "x.pos").string();
-  auto summary = app::run_process(c);
+  auto summary = commands::run_process(c);
   ASSERT_FALSE(summary.ok());
   EXPECT_NE(summary.error().message.find("no base position"), std::string::npos);
   EXPECT_EQ(summary.error().file, no_pos.string());
@@ -428,7 +428,7 @@ TEST(RtkBadInput, NoCommonSatellitesGivesSinglePointAndGoesOn) {
   auto run =
       run_rtk("no_common", "cssrlib-static-doy078/SEPT078M1.21O", "cssrlib-static-doy078/3034078M1.21O",
               {"cssrlib-static-doy078/SEPT078M.21P"}, Eigen::Vector3d(-3959400.631, 3385704.533, 3667523.111),
-              [](app::ProcessConfig& c) {
+              [](config::ProcessConfig& c) {
                 for (int prn = 1; prn <= 32; ++prn)
                   c.rtk.observables.excluded.push_back({core::Constellation::Gps, static_cast<std::uint8_t>(prn)});
                 c.rtk.observables.use_galileo = c.rtk.observables.use_qzss = false;
@@ -450,7 +450,7 @@ TEST(RtkOutput, NmeaGgaBesideThePosFile) {
   const fs::path nmea = test::temp_dir("rtk") / "static.nmea";
   auto run = run_rtk("static_nmea", "cssrlib-static-doy078/SEPT078M1.21O", "cssrlib-static-doy078/3034078M1.21O",
                      {"cssrlib-static-doy078/SEPT078M.21P"}, Eigen::Vector3d(-3959400.631, 3385704.533, 3667523.111),
-                     [&](app::ProcessConfig& c) { c.nmea_out = nmea.string(); });
+                     [&](config::ProcessConfig& c) { c.nmea_out = nmea.string(); });
   ASSERT_TRUE(run.has_value());
   std::ifstream in(nmea);
   std::string line;
@@ -524,7 +524,7 @@ TEST(RtkIonosphere, EstimatedIonosphereHandlesA20KmDifferentialDelay) {
     auto run =
         run_rtk("iono", rover.string(), dir + "Base-static_MO_Spirent.obs",
                 {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
-                base, [&](app::ProcessConfig& c) {
+                base, [&](config::ProcessConfig& c) {
                   c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                   c.rtk.troposphere_saastamoinen = false;
                   c.spp.troposphere_saastamoinen = c.spp.ionosphere_klobuchar = false;
@@ -591,7 +591,7 @@ TEST(RtkEpochMatching, FiveMillisecondClockOffsetAndLowerRateBase) {
     auto run =
         run_rtk("matching", rover_path.string(), base_path.string(),
                 {"instinct-spirent-rtk-sim/RINEX_GN_Spirent.23N", "instinct-spirent-rtk-sim/RINEX_EN_Spirent.23L"},
-                p_E_base, [&](app::ProcessConfig& c) {
+                p_E_base, [&](config::ProcessConfig& c) {
                   c.rtk.ar_mode = mode;
                   c.rtk.observables.use_glonass = c.rtk.observables.use_beidou = false;
                   c.rtk.troposphere_saastamoinen = false;
@@ -658,7 +658,7 @@ TEST(RtkEpochFlags, CycleSlipRecordsAreNotObservationsAndPowerFailureResetsLock)
   ASSERT_TRUE(io::write_rinex_obs(power_path.string(), rover->header, rover->epochs).ok());
   auto power = run_rtk("flags", power_path.string(), "cssrlib-static-doy078/3034078M1.21O",
                        {"cssrlib-static-doy078/SEPT078M.21P"}, base,
-                       [](app::ProcessConfig& c) { c.rtk.ar_mode = rtk::ArMode::Continuous; });
+                       [](config::ProcessConfig& c) { c.rtk.ar_mode = rtk::ArMode::Continuous; });
   ASSERT_TRUE(power.has_value());
   EXPECT_TRUE(std::any_of(power->summary.warnings.begin(), power->summary.warnings.end(),
                           [](const std::string& w) { return w.find("power failure") != std::string::npos; }));

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "canyon/app/process.hpp"
+#include "canyon/commands/process.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
 #include "canyon/io/rinex_obs.hpp"
@@ -46,8 +46,8 @@ const Dataset kDatasets[] = {
      "G,E"},
 };
 
-app::ProcessConfig canyon_config(const Dataset& d, const fs::path& out) {
-  app::ProcessConfig c;
+config::ProcessConfig canyon_config(const Dataset& d, const fs::path& out) {
+  config::ProcessConfig c;
   c.rover_obs = (shared_data() / d.rover).string();
   for (const char* n : d.nav) c.nav.push_back((shared_data() / n).string());
   c.out = out.string();
@@ -64,13 +64,13 @@ app::ProcessConfig canyon_config(const Dataset& d, const fs::path& out) {
 struct BothSolutions {
   std::vector<core::Solution> canyon;
   std::vector<core::Solution> rtklib;
-  app::ProcessSummary summary;
+  commands::ProcessSummary summary;
 };
 
 std::optional<BothSolutions> run_both(const Dataset& d) {
   const fs::path dir = test::temp_dir(std::string("spp_") + d.name);
-  const app::ProcessConfig config = canyon_config(d, dir / "canyon.pos");
-  auto summary = app::run_process(config);
+  const config::ProcessConfig config = canyon_config(d, dir / "canyon.pos");
+  auto summary = commands::run_process(config);
   EXPECT_TRUE(summary.ok()) << summary.error().to_string();
   if (!summary) return std::nullopt;
   const fs::path conf = test::write_rtklib_spp_conf(dir, d.systems);
@@ -143,7 +143,7 @@ TEST(SppAccuracy, InstinctSimulatorWithinOneMetre) {
   const fs::path truth_file = shared_data() / "instinct-spirent-rtk-sim/truth_rover_dynamic_ecef_10Hz.pos";
   if (!fs::exists(truth_file)) GTEST_SKIP() << "shared dataset not present: " << truth_file;
   const fs::path dir = test::temp_dir("spp_instinct");
-  auto summary = app::run_process(canyon_config(d, dir / "canyon.pos"));
+  auto summary = commands::run_process(canyon_config(d, dir / "canyon.pos"));
   ASSERT_TRUE(summary.ok()) << summary.error().to_string();
   auto sols = io::read_pos_file((dir / "canyon.pos").string());
   auto truth = io::read_pos_file(truth_file.string());
@@ -170,9 +170,9 @@ TEST(SppProcess, EpochsWithTooFewSatellitesAreSkippedAndProcessingGoesOn) {
   const Dataset& d = kDatasets[0];
   if (!fs::exists(shared_data() / d.rover)) GTEST_SKIP() << "shared dataset not present";
   const fs::path dir = test::temp_dir("spp_few");
-  app::ProcessConfig config = canyon_config(d, dir / "x.pos");
+  config::ProcessConfig config = canyon_config(d, dir / "x.pos");
   config.spp.elevation_mask_rad = 60.0 * core::kDegToRad;  // leaves 0-4 satellites per epoch
-  auto summary = app::run_process(config);
+  auto summary = commands::run_process(config);
   ASSERT_TRUE(summary.ok()) << summary.error().to_string();
   EXPECT_EQ(summary->epochs, 120);
   EXPECT_LT(summary->solved, 120);

@@ -19,7 +19,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "canyon/app/scenario_config.hpp"
+#include "canyon/config/scenario_config.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/eval/truth.hpp"
 #include "canyon/gnss/atmosphere.hpp"
@@ -38,7 +38,7 @@ constexpr double kMaxFractionCyc = 0.15;                     // |DD phase - DD r
 constexpr double kMinElevationRad = 15.0 * core::kDegToRad;  // where the truth's troposphere is Saastamoinen's
 
 Scenario shipped(const std::string& name) {
-  auto s = app::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config" / "scenarios" / (name + ".yaml")).string());
+  auto s = config::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config" / "scenarios" / (name + ".yaml")).string());
   EXPECT_TRUE(s.ok()) << s.error().to_string();
   return *s;
 }

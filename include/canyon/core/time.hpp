@@ -74,6 +74,9 @@ struct CalendarTime {
 /// Calendar time read on the GPST scale -> GpsTime, and back.
 [[nodiscard]] GpsTime calendar_to_gps(const CalendarTime& c);
 [[nodiscard]] CalendarTime gps_to_calendar(const GpsTime& t);
+/// "2021-03-19 12:00:00", "2021/03/19 12:00:00" or a date alone ("2021-03-19", midnight), read as GPST; nullopt
+/// if malformed.
+[[nodiscard]] std::optional<GpsTime> parse_gps_calendar(const std::string& text);
 
 /// Leap seconds: GPST - UTC, from a table of the UTC instants at which each new value took effect.
 class LeapSecondTable {

@@ -200,7 +200,7 @@ class FusionEngine {
   /// prediction and no single-point solution). The same as the stages below in order, then flush_alignment().
   Result<FusionEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base);
 
-  // The stages of process(), for the staged pipeline (app/epoch_pipeline.hpp). Per epoch, in this order:
+  // The stages of process(), for the staged pipeline (pipeline/epoch_pipeline.hpp). Per epoch, in this order:
   //   bridge(t) -> align(t, pose) -> predict() -> [if true] update() -> [if true] resolve() -> finish_epoch().
   // bridge() only reads the VIO track and may run ahead on another thread; the others change the engine's state and
   // run one epoch at a time. The alignment that the paper runs after epoch k's solution runs at the start of align()
@@ -228,7 +228,7 @@ class FusionEngine {
   /// Runs an alignment left pending by the last epoch (end of the input).
   void flush_alignment();
 
-  // A live VIO stream (app::LiveVio): poses appended while the stages run. The track is guarded by a reader-writer
+  // A live VIO stream (pipeline::LiveVio): poses appended while the stages run. The track is guarded by a reader-writer
   // lock: appends (the time bridge's thread) exclude the readers (bridge(), the prediction); forgetting happens in
   // align().
   /// Appends a pose at GPST t to the track (VioTrack::append); false if not after the last one.

@@ -2,7 +2,7 @@
 // The filter-independent part of a fusion epoch: the RTK geometry of all the rover's signals (rtk/epoch_geometry.hpp:
 // satellite states, single-point solution, observables, the base's zero differences, the cycle-slip scan) and the
 // C/N0 screen's verdict on them (cn0_screen.hpp). FusionEngine's prediction builds it itself, or takes it built ahead,
-// e.g. on the staged pipeline's time-bridge thread (app/epoch_pipeline.hpp), beside the filter's work on the epoch
+// e.g. on the staged pipeline's time-bridge thread (pipeline/epoch_pipeline.hpp), beside the filter's work on the epoch
 // before.
 //
 // Nothing here reads the filter: the single-point chain, the slip detectors and the screen's learning depend on the

@@ -219,7 +219,7 @@ class RtkEngine {
   /// The same as its three stages in order: predict(); if true, update(); if true, resolve(); then take_epoch().
   Result<RtkEpoch> process(const core::ObsEpoch& rover, const core::ObsEpoch* base, const RtkAiding* aiding = nullptr);
 
-  // The stages of process(), for the staged pipeline (app/epoch_pipeline.hpp); each runs after the one before on
+  // The stages of process(), for the staged pipeline (pipeline/epoch_pipeline.hpp); each runs after the one before on
   // the same epoch, and `aiding` must stay alive until resolve() or take_epoch().
   /// Prediction: single-point solution, time update (aided, or the engine's own motion model), observables, cycle
   /// slips, single differences, ambiguity bookkeeping. Error as process(); true if the epoch goes on to update(),

@@ -2,7 +2,7 @@
 // The part of an RTK epoch that does not depend on the filter: both receivers' observables, the rover's satellite
 // states and single-point solution, and the base's zero-difference models (the base does not move). RtkEngine's
 // prediction builds it itself, or takes it built ahead, e.g. on the staged pipeline's time-bridge thread
-// (app/epoch_pipeline.hpp), where it runs beside the filter's work on the epoch before.
+// (pipeline/epoch_pipeline.hpp), where it runs beside the filter's work on the epoch before.
 //
 // Each single-point solution starts from the one before it, a chain that the filter never touches: a builder fed
 // the same epochs in the same order gives the same geometry wherever it runs. The same holds for the cycle-slip

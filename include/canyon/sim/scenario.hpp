@@ -1,6 +1,6 @@
 #pragma once
 // A simulation scenario: every parameter of `canyon simulate`, with its unit and default. The shipped scenario files
-// (config/scenarios/*.yaml) set these keys; app/scenario_config.hpp reads and writes them (YAML key = field name
+// (config/scenarios/*.yaml) set these keys; config/scenario_config.hpp reads and writes them (YAML key = field name
 // unless noted). Defaults describe the paper's set-up: a pedestrian with a head-worn antenna walking city streets
 // for 10 minutes, GNSS at 5 Hz, GPS + GLONASS + Galileo dual frequency, a base station 20 km away under open sky.
 //

@@ -1,0 +1,85 @@
+#pragma once
+// Configuration of `canyon process`: inputs, mode, output format and the estimator options, from a strict YAML
+// file and/or the command line. Relative paths in a YAML file are relative to that file's folder.
+//
+// YAML keys (all optional; the command line overrides them):
+//   mode: spp                      # processing mode: spp | rtk | fusion
+//   rover: ROVER.obs               # rover RINEX observations (2.x/3.x, may be .gz)
+//   base: BASE.obs                 # base RINEX observations (rtk, fusion)
+//   vio: vio.csv                   # VIO poses (fusion; DESIGN.md contract, io/vio_file.hpp)
+//   timesync: timesync.csv         # the device's GPS time-sync pairs (fusion, unless fusion.vio_clock: gps)
+//   base_position: [X, Y, Z]       # base antenna ECEF (m); default: the base file's APPROX POSITION XYZ
+//   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
+//   out: SOL.pos                   # solution file (RTKLIB .pos format)
+//   nmea: SOL.nmea                 # also write NMEA GGA sentences (optional)
+//   exclude_most_observed: 0       # leave out the N satellites (of the used constellations) tracked in the most
+//                                  # rover epochs: the paper's satellite-exclusion experiment on real data
+//   output:
+//     coordinates: llh             # llh | ecef
+//     time_format: tow             # tow (GPST week, seconds) | calendar (yyyy/mm/dd hh:mm:ss.sss)
+//   spp:                           # the single point: spp mode's solution, the RTK engine's prior and fallback
+//     elevation_mask_deg: 15       # deg
+//     systems: [G, R, E, C, J]     # constellations to use
+//     ionosphere: klobuchar        # klobuchar | off
+//     troposphere: saastamoinen    # saastamoinen | off
+//     code_sigma_m: 0.3            # zenith pseudorange noise (m)
+//     raim_fde: true               # exclude one faulty satellite when the chi-square test fails
+//     max_gdop: 30                 # reject solutions with a larger GDOP
+//     qzss_own_clock: false        # false: QZSS shares the GPS receiver clock
+//     exclude: [G05]               # satellites never used (rtk: exclude likewise keeps them out of both)
+//   rtk:                           # see config/rtk.yaml for every key with its unit and default
+//   fusion:                        # see config/fusion.yaml for every key with its unit and the paper's defaults
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "canyon/core/result.hpp"
+#include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/gnss/spp.hpp"
+#include "canyon/io/pos_file.hpp"
+#include "canyon/rtk/engine.hpp"
+
+namespace canyon::config {
+
+enum class ProcessMode { Spp, Rtk, Fusion };
+
+struct ProcessConfig {
+  ProcessMode mode = ProcessMode::Spp;
+  std::string rover_obs;                             ///< rover observation file
+  std::string base_obs;                              ///< base observation file (rtk, fusion)
+  std::string vio;                                   ///< VIO pose file (fusion)
+  std::string timesync;                              ///< time-sync file (fusion with a device clock)
+  std::optional<Eigen::Vector3d> base_position_E_m;  ///< base antenna position (ECEF, m); header position if unset
+  std::vector<std::string> nav;                      ///< navigation files
+  std::string out;                                   ///< solution file
+  std::string nmea_out;                              ///< NMEA GGA file written beside the .pos when set
+  int exclude_most_observed = 0;                     ///< leave out the N most observed satellites (>= 0)
+  io::PosCoordinates coordinates = io::PosCoordinates::Llh;
+  io::PosTimeFormat time_format = io::PosTimeFormat::WeekTow;
+  gnss::SppOptions spp;
+  rtk::RtkOptions rtk;
+  fusion::FusionOptions fusion;
+
+  /// Empty if complete and consistent, else the first violated rule ("rover observation file is required").
+  [[nodiscard]] std::string validate() const;
+
+  /// The RTK engine's options (rtk and fusion modes): `rtk` with its single-point solution (the prior, the fallback,
+  /// fusion's integrity reference) configured by `spp`, and a satellite excluded in either section left out of both.
+  [[nodiscard]] rtk::RtkOptions rtk_engine_options() const;
+};
+
+[[nodiscard]] bool operator==(const ProcessConfig& a, const ProcessConfig& b);
+
+/// Parses a YAML node; `file` names the source in errors and anchors relative paths.
+Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file,
+                                           ProcessConfig defaults = {});
+Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig defaults = {});
+/// The configuration as YAML that parse_process_config() reads back to an equal configuration.
+[[nodiscard]] std::string to_yaml(const ProcessConfig& config);
+
+[[nodiscard]] std::string mode_name(ProcessMode mode);
+
+}  // namespace canyon::config

@@ -1,0 +1,59 @@
+#pragma once
+// `canyon rover` configuration (config/rover.yaml documents every key): strict YAML parsing, printing, comparison
+// and validation. No DDS here: the rover executable (src/apps/canyon_rover_main.cpp) reads it.
+
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+#include "canyon/config/process_config.hpp"
+#include "canyon/core/result.hpp"
+#include "canyon/pipeline/byte_link.hpp"
+#include "canyon/pipeline/epoch_pipeline.hpp"
+
+namespace canyon::config {
+
+enum class RoverInputKind { Rinex, Ubx };
+enum class RoverBaseSource { File, Dds, Ntrip, Tcp };
+[[nodiscard]] const char* rover_base_source_name(RoverBaseSource source);
+
+struct RoverConfig {
+  /// The estimator and its inputs: the keys of `canyon process` (mode rtk or fusion, rover, base, nav, vio,
+  /// timesync, base_position, rtk, fusion, output; `out`: a .pos the rover writes itself, optional).
+  ProcessConfig estimator;
+  std::string rover_id = "rover";  ///< names the rover in its messages
+  double pace = 1.0;               ///< rover file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible
+  RoverInputKind rover = RoverInputKind::Rinex;  ///< rinex: estimator.rover; ubx: a u-blox receiver at rover_source
+  std::string rover_source;  ///< ubx: file:PATH (replayed at pace), serial:///dev/X?baud=N, tcp://HOST:PORT, ntrip://
+  RoverBaseSource base = RoverBaseSource::File;  ///< file: estimator.base; dds: RtcmFrame samples; ntrip, tcp: RTCM 3
+  std::string base_source;         ///< ntrip: ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT; tcp: tcp://HOST:PORT
+  bool stream_ephemerides = true;  ///< add the ephemerides of the UBX (SFRBX) and RTCM streams to estimator.nav's
+  pipeline::LinkOptions link;      ///< attempts, stall_timeout_s of the network links (rover and base)
+  double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (streamed), from when it is due
+  double ntrip_gga_interval_s = 0.0;  ///< base ntrip: upload the rover's latest position as GGA this often (0: never)
+  std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
+  bool vio_dds = false;                  ///< fusion: VIO and time sync from DDS (vio_topic, timesync_topic), not files
+  double vio_wait_s = 0.2;               ///< dds VIO: longest an epoch waits for the VIO to cover it (s)
+  std::size_t vio_queue_poses = 4096;  ///< dds VIO: poses between the DDS listener and the time bridge; beyond: dropped
+  pipeline::PipelineOptions pipeline{true, 64};  ///< threaded, queue_capacity
+  int domain = 0;                                ///< DDS domain id
+  std::string profiles;                          ///< Fast DDS XML profiles ("": config/dds/canyon_profiles.xml)
+  std::string rtcm_topic = "canyon/rtcm";
+  std::string solution_topic = "canyon/solution";
+  std::string timing_topic = "canyon/timing";
+  std::string vio_topic = "canyon/vio";            ///< canyon::msg::VioPose in (input.vio dds)
+  std::string timesync_topic = "canyon/timesync";  ///< canyon::msg::TimeSyncSample in (input.vio dds)
+  bool publish_stages = true;  ///< also canyon/bridged, canyon/alignment, canyon/prior, canyon/float
+
+  /// Empty if usable, else the first broken rule.
+  [[nodiscard]] std::string validate() const;
+  /// Whether the base comes as RTCM 3 that streams in (dds, ntrip, tcp).
+  [[nodiscard]] bool streamed_base() const { return base != RoverBaseSource::File; }
+};
+
+[[nodiscard]] bool operator==(const RoverConfig& a, const RoverConfig& b);
+Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string& file);
+Result<RoverConfig> load_rover_config(const std::string& path);
+[[nodiscard]] std::string to_yaml(const RoverConfig& config);
+
+}  // namespace canyon::config

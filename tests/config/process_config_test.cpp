@@ -1,0 +1,249 @@
+#include "canyon/config/process_config.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "canyon/core/constants.hpp"
+
+namespace canyon::config {
+namespace {
+
+namespace fs = std::filesystem;
+
+Result<ProcessConfig> parse(const std::string& text) {
+  return parse_process_config(YAML::Load(text), "test.yaml");
+}
+
+TEST(ProcessConfigTest, EveryShippedConfigLoads) {
+  const fs::path config_dir = fs::path(CANYON_SOURCE_DIR) / "config";
+  int loaded = 0;
+  for (const auto& entry : fs::directory_iterator(config_dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    const YAML::Node node = YAML::LoadFile(entry.path().string());
+    if (!node["mode"]) continue;  // not a process configuration (scenarios etc. have their own tests)
+    auto config = load_process_config(entry.path().string());
+    ASSERT_TRUE(config.ok()) << config.error().to_string();
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 2);
+}
+
+TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {
+  auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/spp.yaml");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(*config, ProcessConfig{});
+  auto rtk = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/rtk.yaml");
+  ASSERT_TRUE(rtk.ok()) << rtk.error().to_string();
+  ProcessConfig expected;
+  expected.mode = ProcessMode::Rtk;
+  EXPECT_EQ(to_yaml(*rtk), to_yaml(expected));
+  // config/fusion.yaml: every fusion key at its default; the rtk section sets what it says.
+  auto fusion = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/fusion.yaml");
+  ASSERT_TRUE(fusion.ok()) << fusion.error().to_string();
+  ProcessConfig expected_fusion;
+  expected_fusion.mode = ProcessMode::Fusion;
+  expected_fusion.rtk.ar_mode = rtk::ArMode::FixAndHold;
+  expected_fusion.rtk.ionosphere = rtk::IonosphereModel::Estimate;
+  expected_fusion.rtk.float_consistency_level = 0.001;
+  expected_fusion.rtk.snr_weighting = true;
+  expected_fusion.rtk.ambiguity_noise_cyc = 0.01;
+  EXPECT_EQ(to_yaml(*fusion), to_yaml(expected_fusion));
+}
+
+TEST(ProcessConfigTest, FusionOptionsParseValidateAndRoundTrip) {
+  auto config = parse(R"(
+mode: fusion
+base: base.obs
+vio: vio.csv
+timesync: sync/timesync.csv
+fusion: {gate: chi_square, prediction: constant_velocity, lever_arm_prior_m: [0.1, 0, 0.12], alignment_max_rmse_m: 0.05,
+         vio_clock: gps, cn0_screen: true, false_fix_guard: false}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(config->mode, ProcessMode::Fusion);
+  EXPECT_EQ(config->vio, "vio.csv");
+  EXPECT_EQ(config->timesync, "sync/timesync.csv");
+  EXPECT_EQ(config->fusion.gate, fusion::InnovationGate::ChiSquare);
+  EXPECT_EQ(config->fusion.prediction, fusion::Prediction::ConstantVelocity);
+  EXPECT_DOUBLE_EQ(config->fusion.lever_arm_prior_m.z(), 0.12);
+  EXPECT_DOUBLE_EQ(config->fusion.alignment.max_rmse_m, 0.05);
+  EXPECT_TRUE(config->fusion.vio_on_gps_time);
+  EXPECT_TRUE(config->fusion.cn0.enabled);
+  EXPECT_FALSE(config->fusion.false_fix_guard);
+  auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+  // Unknown keys and bad values are errors naming the key.
+  for (const char* bad : {"fusion: {gate: sometimes}", "fusion: {prediction: imu}", "fusion: {alignment_max_fer: 2}",
+                          "fusion: {lever_arm_prior_m: [1, 2]}", "fusion: {vio_clock: utc}", "fusion: {ratio: 3}",
+                          "fusion: {alignment_max_rmse_m: -1}"}) {
+    const auto r = parse(bad);
+    ASSERT_FALSE(r.ok()) << bad;
+    EXPECT_NE(r.error().to_string().find("test.yaml"), std::string::npos) << r.error().to_string();
+  }
+  // What fusion needs.
+  ProcessConfig c;
+  c.mode = ProcessMode::Fusion;
+  c.rover_obs = "r.obs";
+  c.nav = {"n.nav"};
+  c.out = "x.pos";
+  c.base_obs = "b.obs";
+  EXPECT_NE(c.validate().find("VIO file"), std::string::npos) << c.validate();
+  c.vio = "vio.csv";
+  EXPECT_NE(c.validate().find("time-sync file"), std::string::npos) << c.validate();
+  c.fusion.vio_on_gps_time = true;
+  EXPECT_EQ(c.validate(), "");
+}
+
+TEST(ProcessConfigTest, RtkOptionsParseAndRoundTrip) {
+  auto config = parse(R"(
+mode: rtk
+base: /data/base.obs
+base_position: [-3959400.631, 3385704.533, 3667523.111]
+rtk: {ar_mode: fix_and_hold, frequencies: 1, systems: [G, R], glonass_ar: on, ionosphere: estimate, exclude: [R07]}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(config->mode, ProcessMode::Rtk);
+  EXPECT_EQ(config->rtk.ar_mode, rtk::ArMode::FixAndHold);
+  EXPECT_EQ(config->rtk.observables.num_frequencies, 1);
+  EXPECT_TRUE(config->rtk.glonass_ar);
+  EXPECT_EQ(config->rtk.ionosphere, rtk::IonosphereModel::Estimate);
+  ASSERT_TRUE(config->base_position_E_m.has_value());
+  EXPECT_NEAR(config->base_position_E_m->x(), -3959400.631, 1e-6);
+  auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+  for (const char* bad : {"rtk: {ar_mode: sometimes}", "rtk: {frequencies: 4}", "base_position: [1, 2]",
+                          "rtk: {glonass_ar: maybe}", "rtk: {ionosphere: klobuchar}", "rtk: {ratio: 3}"}) {
+    EXPECT_FALSE(parse(bad).ok()) << bad;
+  }
+}
+
+// The RTK engine's single-point solution is the one `spp:` configures (it was left at SppOptions' defaults before:
+// the satellite-exclusion experiment's excluded satellites still fed canyon rtk's prior), and an exclusion in either
+// section holds for both.
+TEST(ProcessConfigTest, RtkEngineUsesTheSppSectionAndBothExclusions) {
+  auto config = parse(R"(
+mode: rtk
+base: /data/base.obs
+spp: {elevation_mask_deg: 20, systems: [G], ionosphere: off, exclude: [G05]}
+rtk: {systems: [G, E], exclude: [E11]}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  const rtk::RtkOptions o = config->rtk_engine_options();
+  EXPECT_NEAR(o.spp.elevation_mask_rad, 20.0 * core::kDegToRad, 1e-12);
+  EXPECT_TRUE(o.spp.use_gps);
+  EXPECT_FALSE(o.spp.use_galileo);
+  EXPECT_FALSE(o.spp.ionosphere_klobuchar);
+  const auto names = [](const std::vector<core::SatelliteId>& sats) {
+    std::string out;
+    for (const core::SatelliteId& s : sats) out += s.to_string() + " ";
+    return out;
+  };
+  EXPECT_EQ(names(o.spp.excluded), "G05 E11 ");
+  EXPECT_EQ(names(o.observables.excluded), "E11 G05 ");
+  EXPECT_TRUE(o.observables.use_galileo);                      // the RTK's own systems stay
+  EXPECT_EQ(names(config->rtk.observables.excluded), "E11 ");  // the sections themselves are not changed
+}
+
+TEST(ProcessConfigTest, PrintsAndParsesBackEqual) {
+  auto config = parse(R"(
+mode: spp
+rover: /data/rover.obs
+nav: [/data/a.nav, /data/b.nav]
+out: /tmp/x.pos
+output: {coordinates: ecef, time_format: calendar}
+spp: {elevation_mask_deg: 10, systems: [G, E], ionosphere: off, raim_fde: false, exclude: [G05, E11]}
+)");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_NEAR(config->spp.elevation_mask_rad, 10.0 * core::kDegToRad, 1e-12);
+  EXPECT_FALSE(config->spp.use_glonass);
+  EXPECT_TRUE(config->spp.use_galileo);
+  EXPECT_EQ(config->spp.excluded.size(), 2U);
+  EXPECT_EQ(config->coordinates, io::PosCoordinates::Ecef);
+  auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+}
+
+TEST(ProcessConfigTest, RelativePathsAreRelativeToTheFile) {
+  auto config = parse_process_config(YAML::Load("rover: obs/r.obs\nnav: n.nav\n"), "/etc/canyon/x.yaml");
+  ASSERT_TRUE(config.ok());
+  EXPECT_EQ(config->rover_obs, "/etc/canyon/obs/r.obs");
+  EXPECT_EQ(config->nav, std::vector<std::string>{"/etc/canyon/n.nav"});
+}
+
+struct BadConfig {
+  const char* yaml;
+  const char* expected_in_message;
+  int line;
+};
+
+TEST(ProcessConfigTest, RejectsBadConfigsNamingKeyAndLine) {
+  const BadConfig cases[] = {
+      {"mode: spp\nrovr: a.obs\n", "unknown key 'rovr'", 2},
+      {"spp:\n  elevation_mask_deg: 15\n  elev_mask: 10\n", "unknown key 'spp.elev_mask'", 3},
+      {"spp:\n  elevation_mask_deg: high\n", "'spp.elevation_mask_deg' must be a number", 2},
+      {"spp:\n  systems: [G, X]\n", "'spp.systems' has 'X'", 2},
+      {"mode: ppp\n", "'mode' must be spp", 1},
+      {"output:\n  coordinates: utm\n", "'output.coordinates' must be llh or ecef", 2},
+      {"spp:\n  raim_fde: maybe\n", "'spp.raim_fde' must be true or false", 2},
+      {"spp:\n  exclude: [G99]\n", "'spp.exclude' has 'G99'", 2},
+      {"spp: 5\n", "'spp' must be a map", 1},
+      {"- a\n- b\n", "top level must be a map", 1},
+      {"rtk:\n  ionosphere: sometimes\n", "'rtk.ionosphere' must be off, estimate or auto", 2},
+  };
+  for (const auto& c : cases) {
+    auto config = parse(c.yaml);
+    ASSERT_FALSE(config.ok()) << c.yaml;
+    EXPECT_NE(config.error().message.find(c.expected_in_message), std::string::npos)
+        << c.yaml << " -> " << config.error().message;
+    EXPECT_EQ(config.error().file, "test.yaml");
+    EXPECT_EQ(config.error().line, c.line) << c.yaml;
+  }
+}
+
+TEST(ProcessConfigTest, RejectsInvalidValues) {
+  auto config = parse("spp:\n  elevation_mask_deg: 95\n");
+  ASSERT_FALSE(config.ok());
+  EXPECT_NE(config.error().message.find("elevation_mask_rad"), std::string::npos);
+  auto none = parse("spp:\n  systems: []\n");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().message.find("at least one system"), std::string::npos);
+}
+
+TEST(ProcessConfigTest, IonosphereIsAutoByDefaultAndEachModeParses) {
+  auto defaults = parse("mode: rtk\n");
+  ASSERT_TRUE(defaults.ok()) << defaults.error().to_string();
+  EXPECT_EQ(defaults->rtk.ionosphere, rtk::IonosphereModel::Auto);
+  EXPECT_EQ(defaults->rtk.iono_auto_baseline_km, 10.0);
+  for (const auto& [text, model] :
+       {std::pair{"off", rtk::IonosphereModel::Off}, std::pair{"estimate", rtk::IonosphereModel::Estimate},
+        std::pair{"auto", rtk::IonosphereModel::Auto}}) {
+    auto config = parse(std::string("mode: rtk\nrtk:\n  ionosphere: ") + text + "\n  iono_auto_baseline_km: 5\n");
+    ASSERT_TRUE(config.ok()) << text;
+    EXPECT_EQ(config->rtk.ionosphere, model);
+    EXPECT_EQ(config->rtk.iono_auto_baseline_km, 5.0);
+  }
+  auto negative = parse("mode: rtk\nrtk:\n  iono_auto_baseline_km: -1\n");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_NE(negative.error().message.find("iono_auto_baseline_km"), std::string::npos);
+}
+
+TEST(ProcessConfigTest, YamlSyntaxErrorNamesTheLine) {
+  const fs::path path = fs::temp_directory_path() / "canyon_bad_syntax.yaml";
+  std::ofstream(path) << "mode: spp\nspp: {elevation_mask_deg: 10\n";
+  auto config = load_process_config(path.string());
+  ASSERT_FALSE(config.ok());
+  EXPECT_NE(config.error().message.find("YAML syntax error"), std::string::npos);
+  EXPECT_EQ(config.error().file, path.string());
+  EXPECT_GT(config.error().line, 0);
+  auto missing = load_process_config("/nonexistent/canyon.yaml");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("cannot open"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace canyon::config
