@@ -119,11 +119,13 @@ FusionEngine::FusionEngine(FusionOptions options, const rtk::RtkOptions& rtk_opt
       track_(std::move(track)),
       t_IA_m_(options_.lever_arm_prior_m) {}
 
-std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose) {
+std::optional<FusionEngine::EpochAiding> FusionEngine::make_aiding(const core::GpsTime& t,
+                                                                   const std::optional<VioPoseAt>& pose) {
   prior_.reset();
   if (!engine_.has_position() || !engine_.state_time()) return std::nullopt;
   const core::GpsTime t_state = *engine_.state_time();
-  rtk::RtkAiding aiding;
+  EpochAiding epoch_aiding;
+  rtk::ExternalMotion& aiding = epoch_aiding.motion;
   const Eigen::Vector3d p_state = engine_.position_E_m();
   if (options_.prediction == Prediction::Vio) {
     if (!alignment_ || !pose || pose->segment != alignment_->segment) return std::nullopt;
@@ -173,24 +175,39 @@ std::optional<rtk::RtkAiding> FusionEngine::make_aiding(const core::GpsTime& t, 
   prior_ = prior;
   const double motion_m = aiding.delta_p_E_m.norm();
   if (options_.gate == InnovationGate::Paper || options_.gate == InnovationGate::Both) {
-    aiding.max_phase_innovation_m = std::max(options_.gate_motion_factor * motion_m, options_.min_gate_m);
+    epoch_aiding.gate.max_phase_innovation_m = std::max(options_.gate_motion_factor * motion_m, options_.min_gate_m);
   }
   if (options_.gate == InnovationGate::ChiSquare || options_.gate == InnovationGate::Both) {
-    aiding.max_normalised_innovation = options_.gate_sigmas;
+    epoch_aiding.gate.max_normalised_innovation = options_.gate_sigmas;
   }
+  return epoch_aiding;
+}
+
+bool FusionEngine::accept_fix(const rtk::FixCandidate& fix) {
+  if (!fix.position_ok) return false;
+  const Eigen::Vector3d& p_fix = fix.p_E_m;
+  const Eigen::Matrix3d& P_fix = fix.P_E_m2;
   const double bound = options_.false_fix_guard ? options_.false_fix_chi2 : -1.0;
   const double max_variance = options_.max_fix_sigma_m * options_.max_fix_sigma_m;
-  aiding.accept_fix = [this, prior, bound, max_variance](const Eigen::Vector3d& p_fix, const Eigen::Matrix3d& P_fix) {
-    if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_fix, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff() >
-        max_variance) {
-      ++undetermined_fixes_epoch_;
-      return false;
-    }
-    if (bound < 0.0 || chi2(p_fix - prior.p_E_m, prior.P_E_m2 + P_fix) <= bound) return true;
-    ++guard_rejections_epoch_;
+  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_fix, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff() >
+      max_variance) {
+    ++undetermined_fixes_epoch_;
     return false;
-  };
-  return aiding;
+  }
+  if (bound < 0.0 || chi2(p_fix - prior_->p_E_m, prior_->P_E_m2 + P_fix) <= bound) return true;
+  ++guard_rejections_epoch_;
+  return false;
+}
+
+bool VioGates::passes(const rtk::DdInnovation& row) const {
+  const std::optional<double>& fixed_gate = row.phase() ? max_phase_innovation_m : max_code_innovation_m;
+  if (!fixed_gate && !max_normalised_innovation) return true;
+  const double hPh = row.predicted_variance_m2();
+  const double r = row.measurement_variance_m2();
+  const double v = std::abs(row.innovation_m());
+  // A fixed gate judges only rows whose prediction is good to a third of it (not a new ambiguity).
+  if (fixed_gate && 9.0 * hPh <= *fixed_gate * *fixed_gate && v > *fixed_gate) return false;
+  return !(max_normalised_innovation && v > *max_normalised_innovation * std::sqrt(hPh + r));
 }
 
 std::string FusionEngine::validate_float(const rtk::RtkEpoch& epoch) const {
@@ -272,7 +289,7 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
   }
   epoch_spp_p_E_m_.reset();
   if (geometry->rtk.spp) epoch_spp_p_E_m_ = geometry->rtk.spp->p_E_m;
-  auto more = engine_.predict(rover, base, aiding_ ? &*aiding_ : nullptr, &geometry->rtk);
+  auto more = engine_.predict(rover, base, aiding_ ? &aiding_->motion : nullptr, &geometry->rtk);
   if (!more) {
     if (!aiding_) heading_free_epoch_ = heading_free_solution(rover.time, pose);
     if (heading_free_epoch_) return false;  // finish_epoch() outputs it
@@ -287,11 +304,17 @@ FusionGeometryBuilder FusionEngine::make_geometry_builder() const {
 }
 
 bool FusionEngine::update() {
-  return engine_.update();
+  return engine_.update(aiding_ ? &aiding_->gate : nullptr);
 }
 
 void FusionEngine::resolve() {
-  engine_.resolve();
+  if (!aiding_) {
+    engine_.resolve();
+    return;
+  }
+  rtk::FixSearch& search = engine_.propose_fixes();
+  while (const rtk::FixCandidate* candidate = search.next()) search.decide(accept_fix(*candidate));
+  engine_.conclude_fixes();
 }
 
 void FusionEngine::count_fix_rejections() {

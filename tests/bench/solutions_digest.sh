@@ -6,7 +6,7 @@
 #              timed run): canyon rtk (config/rtk-urban.yaml) and fusion (config/fusion.yaml), every ablation, and
 #              instinct with VIO from its truth and satellites excluded
 #   layouts    canyon process --pipeline sequential | bridge-ahead | threaded on urban-severe seed 1 (fusion) and on
-#              instinct (rtk)
+#              instinct (rtk), and instinct with the constant-acceleration model (rtk dynamics)
 #   spp        canyon process --mode spp on the shared datasets of tests/bench/spp_vs_rtklib.sh
 #   demo       canyon demo (its solutions, evaluation and plots)
 #   loopback   tests/bench/rover_loopback.sh both: the DDS rover's recorded .pos (equal to canyon process, checked
@@ -87,6 +87,11 @@ part_layouts() {
       --base "$obs/Base-static_MO_Spirent.obs" --nav "$inst/RINEX_GN_Spirent.23N" --nav "$inst/RINEX_EN_Spirent.23L" \
       --pipeline "$layout" --out "$tmp/rtk-$layout.pos" --nmea "$tmp/rtk-$layout.nmea" || return 1
   done
+  # The constant-acceleration model (rtk dynamics), which no shipped configuration uses.
+  sed 's/^  dynamics: .*/  dynamics: true/' "$root/config/rtk.yaml" > "$tmp/rtk-dynamics.yaml"
+  "$canyon" process -q --config "$tmp/rtk-dynamics.yaml" --rover "$obs/Rover-dynamic_MO_Spirent.obs" \
+    --base "$obs/Base-static_MO_Spirent.obs" --nav "$inst/RINEX_GN_Spirent.23N" --nav "$inst/RINEX_EN_Spirent.23L" \
+    --out "$tmp/rtk-dynamics.pos" || return 1
   keep layouts "$tmp" '*.pos' '*.nmea'
   rm -rf "$tmp"
 }

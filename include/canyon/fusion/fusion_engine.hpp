@@ -191,6 +191,14 @@ struct FusionStats {
   std::vector<std::string> notes;  ///< VIO segments, alignment losses
 };
 
+/// The fusion's innovation gates on one epoch's DD rows (rtk::InnovationGate).
+struct VioGates final : rtk::InnovationGate {
+  std::optional<double> max_phase_innovation_m;     ///< DD phase innovations beyond are rejected (m)
+  std::optional<double> max_code_innovation_m;      ///< DD code innovations beyond are rejected (m)
+  std::optional<double> max_normalised_innovation;  ///< |v| / sqrt(h P h^T + r) beyond is rejected
+  [[nodiscard]] bool passes(const rtk::DdInnovation& row) const override;
+};
+
 class FusionEngine {
  public:
   FusionEngine(FusionOptions options, const rtk::RtkOptions& rtk_options, const gnss::EphemerisStore& ephemerides,
@@ -278,7 +286,12 @@ class FusionEngine {
   };
   void count_fix_rejections();
 
-  std::optional<rtk::RtkAiding> make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
+  struct EpochAiding {
+    rtk::ExternalMotion motion;
+    VioGates gate;
+  };
+  std::optional<EpochAiding> make_aiding(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
+  bool accept_fix(const rtk::FixCandidate& fix);
   /// The antenna's VIO increment from the track's pose at GPST t_from to `pose` (vio_increment(), Eqs. 4-5), nullopt
   /// if the track has no pose at t_from in pose's segment.
   [[nodiscard]] std::optional<VioIncrement> increment_since(
@@ -344,7 +357,7 @@ class FusionEngine {
   // The epoch between the stages.
   core::GpsTime epoch_time_;
   std::optional<VioPoseAt> epoch_pose_;
-  std::optional<rtk::RtkAiding> aiding_;  // alive from predict() to finish_epoch(): the RTK engine points to it
+  std::optional<EpochAiding> aiding_;  // alive from predict() to finish_epoch(): the RTK engine points to it
   std::optional<Eigen::Vector3d> epoch_spp_p_E_m_;  // the epoch's single point, if any
   std::deque<SppOffset> spp_offsets_;               // integrity_check's window
   std::vector<double> median_scratch_m_;            // its medians' working copy (kept: no allocation per epoch)

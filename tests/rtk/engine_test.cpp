@@ -1,7 +1,10 @@
-// The RTK engine's aiding hook (rtk::RtkAiding), on a short simulated open-sky scenario: the prior is the state plus
-// the increment with the covariance added, revert_to_prior() restores it, accept_fix vetoes fixes, the gates reject
-// rows, an aided epoch is solved without a single-point solution, and a heading error state of the aiding adds its
-// share to the prior coherently and is learnt from the updates.
+// The RTK engine with an external motion (rtk::ExternalMotion), on a short simulated open-sky scenario: the prior is
+// the state plus the increment with the covariance added, revert_to_prior() restores it, a caller that refuses every
+// proposed fix gets none, an injected gate rejects rows, an epoch with an external motion is solved without a
+// single-point solution, fewer than 4 satellites fix nothing, and a heading error state adds its share to the prior
+// coherently and is learnt from the updates.
+
+#include "canyon/rtk/engine.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +19,6 @@
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
 #include "canyon/gnss/ephemeris.hpp"
-#include "canyon/rtk/engine.hpp"
 #include "canyon/sim/simulator.hpp"
 
 namespace canyon::rtk {
@@ -24,7 +26,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class RtkAidingTest : public ::testing::Test {
+/// A gate with a fixed code threshold (m) and a normalised one (|v| <= k sqrt(h P h^T + r)) on every row.
+class ThresholdGate final : public InnovationGate {
+ public:
+  ThresholdGate(double max_code_m, double max_sigmas) : max_code_m_(max_code_m), max_sigmas_(max_sigmas) {}
+  [[nodiscard]] bool passes(const DdInnovation& row) const override {
+    const double v = std::abs(row.innovation_m());
+    if (!row.phase() && v > max_code_m_) return false;
+    return v <= max_sigmas_ * std::sqrt(row.predicted_variance_m2() + row.measurement_variance_m2());
+  }
+
+ private:
+  double max_code_m_;
+  double max_sigmas_;
+};
+
+class RtkEngineTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     auto scenario = config::load_scenario((fs::path(CANYON_SOURCE_DIR) / "config/scenarios/open-sky.yaml").string());
@@ -62,8 +79,8 @@ class RtkAidingTest : public ::testing::Test {
       ASSERT_TRUE(engine.process(e, base_at(e.time)).ok());
     }
   }
-  static RtkAiding truth_aiding(int k, double sigma_m) {
-    RtkAiding a;
+  static ExternalMotion truth_motion(int k, double sigma_m) {
+    ExternalMotion a;
     a.delta_p_E_m = simulation_->truth[static_cast<std::size_t>(k)].p_E_m -
                     simulation_->truth[static_cast<std::size_t>(k - 1)].p_E_m;
     a.Q_E_m2 = Eigen::Matrix3d::Identity() * sigma_m * sigma_m;
@@ -74,15 +91,15 @@ class RtkAidingTest : public ::testing::Test {
   static gnss::EphemerisStore* ephemerides_;
 };
 
-sim::Simulation* RtkAidingTest::simulation_ = nullptr;
-gnss::EphemerisStore* RtkAidingTest::ephemerides_ = nullptr;
+sim::Simulation* RtkEngineTest::simulation_ = nullptr;
+gnss::EphemerisStore* RtkEngineTest::ephemerides_ = nullptr;
 
-TEST_F(RtkAidingTest, PriorIsTheStatePlusTheIncrementAndRevertRestoresIt) {
+TEST_F(RtkEngineTest, PriorIsTheStatePlusTheIncrementAndRevertRestoresIt) {
   RtkEngine engine(options(), *ephemerides_, simulation_->base_p_E_m);
   run(engine, 10);
   const Eigen::Vector3d p_before = engine.position_E_m();
   const Eigen::Matrix3d P_before = engine.position_covariance_E_m2();
-  const RtkAiding aiding = truth_aiding(10, 0.01);
+  const ExternalMotion aiding = truth_motion(10, 0.01);
   const core::ObsEpoch& e = simulation_->rover.epochs[10];
   auto r = engine.process(e, base_at(e.time), &aiding);
   ASSERT_TRUE(r.ok());
@@ -99,54 +116,61 @@ TEST_F(RtkAidingTest, PriorIsTheStatePlusTheIncrementAndRevertRestoresIt) {
   EXPECT_DOUBLE_EQ(*engine.state_time() - e.time, 0.0);
 }
 
-TEST_F(RtkAidingTest, AcceptFixVetoesEveryFix) {
+TEST_F(RtkEngineTest, ACallerThatRefusesEveryProposedFixGetsNone) {
   RtkEngine free_engine(options(), *ephemerides_, simulation_->base_p_E_m);
-  RtkEngine vetoed(options(), *ephemerides_, simulation_->base_p_E_m);
+  RtkEngine refusing(options(), *ephemerides_, simulation_->base_p_E_m);
   run(free_engine, 5);
-  run(vetoed, 5);
-  int fixed_free = 0, fixed_vetoed = 0, asked = 0;
+  run(refusing, 5);
+  int fixed_free = 0, fixed_refusing = 0, asked = 0;
   for (int k = 5; k < 60; ++k) {
     const core::ObsEpoch& e = simulation_->rover.epochs[static_cast<std::size_t>(k)];
-    RtkAiding a = truth_aiding(k, 0.01);
+    const ExternalMotion a = truth_motion(k, 0.01);
     auto r1 = free_engine.process(e, base_at(e.time), &a);
-    a.accept_fix = [&asked](const Eigen::Vector3d&, const Eigen::Matrix3d&) {
-      ++asked;
-      return false;
-    };
-    auto r2 = vetoed.process(e, base_at(e.time), &a);
-    ASSERT_TRUE(r1.ok() && r2.ok());
+    ASSERT_TRUE(r1.ok());
     fixed_free += r1->solution.status == core::SolutionStatus::Fixed ? 1 : 0;
-    fixed_vetoed += r2->solution.status == core::SolutionStatus::Fixed ? 1 : 0;
+    auto more = refusing.predict(e, base_at(e.time), &a);
+    ASSERT_TRUE(more.ok());
+    if (*more && refusing.update()) {
+      FixSearch& search = refusing.propose_fixes();
+      while (const FixCandidate* candidate = search.next()) {
+        EXPECT_TRUE(candidate->position_ok);
+        EXPECT_GE(candidate->ratio, options().ratio_threshold);  // only candidates that pass rtk's own tests
+        ++asked;
+        search.decide(false);
+      }
+      refusing.conclude_fixes();
+    }
+    fixed_refusing += refusing.take_epoch().solution.status == core::SolutionStatus::Fixed ? 1 : 0;
   }
   EXPECT_GT(fixed_free, 40);
-  EXPECT_EQ(fixed_vetoed, 0);
+  EXPECT_EQ(fixed_refusing, 0);
   EXPECT_GT(asked, 0);
 }
 
-TEST_F(RtkAidingTest, GatesRejectRowsWhosePredictionIsGood) {
+TEST_F(RtkEngineTest, GatesRejectRowsWhosePredictionIsGood) {
   // Fix-and-hold keeps the state at the fix: code rows are predicted to millimetres.
   RtkOptions hold = options();
   hold.ar_mode = ArMode::FixAndHold;
   RtkEngine engine(hold, *ephemerides_, simulation_->base_p_E_m);
   run(engine, 20);
   const core::ObsEpoch& e = simulation_->rover.epochs[20];
-  RtkAiding a = truth_aiding(20, 0.01);
-  a.max_code_innovation_m = 0.05;  // code noise is decimetres: most code rows
-  auto r = engine.process(e, base_at(e.time), &a);
+  const ExternalMotion a = truth_motion(20, 0.01);
+  const ThresholdGate code_gate(0.05, 1e9);  // code noise is decimetres: most code rows
+  auto r = engine.process(e, base_at(e.time), &a, &code_gate);
   ASSERT_TRUE(r.ok());
   EXPECT_GT(r->rejected.size(), 5U);
   engine.revert_to_prior();
   // A normalised gate of 0 sigmas rejects everything: no DD phase is left.
   RtkEngine engine2(options(), *ephemerides_, simulation_->base_p_E_m);
   run(engine2, 20);
-  RtkAiding b = truth_aiding(20, 0.01);
-  b.max_normalised_innovation = 0.0;
-  auto r2 = engine2.process(e, base_at(e.time), &b);
+  const ExternalMotion b = truth_motion(20, 0.01);
+  const ThresholdGate zero_sigmas(1e9, 0.0);
+  auto r2 = engine2.process(e, base_at(e.time), &b, &zero_sigmas);
   ASSERT_TRUE(r2.ok());
   EXPECT_EQ(r2->num_dd_measurements, 0);
 }
 
-TEST_F(RtkAidingTest, AnAidedEpochIsSolvedWithoutASinglePointSolution) {
+TEST_F(RtkEngineTest, AnAidedEpochIsSolvedWithoutASinglePointSolution) {
   RtkEngine engine(options(), *ephemerides_, simulation_->base_p_E_m);
   run(engine, 20);
   // Three satellites of one constellation: no single-point solution, but DD phase against the prior.
@@ -156,7 +180,7 @@ TEST_F(RtkAidingTest, AnAidedEpochIsSolvedWithoutASinglePointSolution) {
   RtkEngine unaided(options(), *ephemerides_, simulation_->base_p_E_m);
   run(unaided, 20);
   EXPECT_FALSE(unaided.process(e, base_at(e.time)).ok());
-  const RtkAiding a = truth_aiding(20, 0.01);
+  const ExternalMotion a = truth_motion(20, 0.01);
   auto r = engine.process(e, base_at(e.time), &a);
   ASSERT_TRUE(r.ok()) << r.error().to_string();
   EXPECT_TRUE(r->aided);
@@ -164,7 +188,7 @@ TEST_F(RtkAidingTest, AnAidedEpochIsSolvedWithoutASinglePointSolution) {
   EXPECT_LT((r->solution.p_E_m - simulation_->truth[20].p_E_m).norm(), 0.5);
 }
 
-TEST_F(RtkAidingTest, NoFixFromFewerThanFourSatellites) {
+TEST_F(RtkEngineTest, NoFixFromFewerThanFourSatellites) {
   // Fixed and held, then aided epochs with GPS satellites tracked on two frequencies only: three of them leave the
   // position open along a line that only the prior holds, so no fix is tried however good the prior (their four DD
   // ambiguities pass min_fix_ambiguities); all of them fix again.
@@ -193,7 +217,7 @@ TEST_F(RtkAidingTest, NoFixFromFewerThanFourSatellites) {
     std::sort(e.sats.begin(), e.sats.end(),
               [&](const core::SatelliteObs& l, const core::SatelliteObs& r) { return elevation(l) > elevation(r); });
     if (k < 30) e.sats.resize(3);
-    const RtkAiding a = truth_aiding(k, 0.001);
+    const ExternalMotion a = truth_motion(k, 0.001);
     auto r = engine.process(e, base_at(e.time), &a);
     ASSERT_TRUE(r.ok()) << r.error().to_string();
     const bool fixed = r->solution.status == core::SolutionStatus::Fixed;
@@ -206,7 +230,7 @@ TEST_F(RtkAidingTest, NoFixFromFewerThanFourSatellites) {
   EXPECT_GT(fixed_all, 5);
 }
 
-TEST_F(RtkAidingTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
+TEST_F(RtkEngineTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
   RtkOptions o = options();
   o.aiding_heading_state = true;
   RtkEngine engine(o, *ephemerides_, simulation_->base_p_E_m);
@@ -224,7 +248,7 @@ TEST_F(RtkAidingTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
   std::vector<Eigen::Vector3d> J;
   for (int k = 10; k < 12; ++k) {
     const core::ObsEpoch& e = simulation_->rover.epochs[static_cast<std::size_t>(k)];
-    RtkAiding a = truth_aiding(k, 0.01);
+    ExternalMotion a = truth_motion(k, 0.01);
     a.dp_d_heading_E_m = Eigen::Vector3d(1.0, -2.0, 0.5) * (k - 8);  // any Jacobian, different per epoch
     a.heading_variance_rad2 = variance;
     a.heading_noise_rad2 = noise;
@@ -248,7 +272,7 @@ TEST_F(RtkAidingTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
   ASSERT_TRUE(engine.process(e12, base_at(e12.time)).ok());
   EXPECT_FALSE(engine.heading_error().has_value());
   const core::ObsEpoch& e13 = simulation_->rover.epochs[13];
-  RtkAiding a = truth_aiding(13, 0.01);
+  ExternalMotion a = truth_motion(13, 0.01);
   a.dp_d_heading_E_m = Eigen::Vector3d(0.3, 0.2, 0.0);
   a.heading_variance_rad2 = 0.04;
   a.heading_noise_rad2 = noise;
@@ -259,7 +283,7 @@ TEST_F(RtkAidingTest, AHeadingErrorStateAddsItsShareOfTheIncrementsCoherently) {
   EXPECT_NEAR(engine.heading_error()->variance_rad2, 0.04 + noise, 1e-15);
 }
 
-TEST_F(RtkAidingTest, TheUpdateLearnsAHeadingErrorFromHowGnssCorrectsTheIncrements) {
+TEST_F(RtkEngineTest, TheUpdateLearnsAHeadingErrorFromHowGnssCorrectsTheIncrements) {
   // The increments are the truth's rotated by 3 degrees about the vertical: the filter's heading error state
   // converges to -3 degrees (the rotation that undoes it) once the rover has moved.
   RtkOptions o = options();
@@ -273,7 +297,7 @@ TEST_F(RtkAidingTest, TheUpdateLearnsAHeadingErrorFromHowGnssCorrectsTheIncremen
   const int n = static_cast<int>(simulation_->rover.epochs.size());
   for (int k = 5; k < n; ++k) {
     const core::ObsEpoch& e = simulation_->rover.epochs[static_cast<std::size_t>(k)];
-    RtkAiding a = truth_aiding(k, 0.002);
+    ExternalMotion a = truth_motion(k, 0.002);
     a.delta_p_E_m = R_error * a.delta_p_E_m;
     a.dp_d_heading_E_m = up_E.cross(a.delta_p_E_m);
     a.heading_variance_rad2 = std::pow(10.0 * core::kDegToRad, 2);

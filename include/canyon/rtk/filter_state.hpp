@@ -1,0 +1,139 @@
+#pragma once
+// The RTK filter's state x and covariance P, and their one owner: every read and write of x and P goes through here.
+//
+// Blocks, in this order (indices from the block accessors, never computed by the caller):
+//   position      p_E_u (3, ECEF, m)
+//   kinematics    v_E_u, a_E_u (6, m/s and m/s^2; with dynamics)
+//   heading       psi (1, rad; the error of an external aiding's heading, with a heading state)
+//   keyed states  one per StateKey, in the order added: an ambiguity N_sd of (satellite, frequency rank) in cycles,
+//                 or a satellite's single-differenced ionosphere I_sd in L1-band metres (frequency kIonosphere).
+// Keyed states come and go every epoch (a satellite rises, a slip resets it); the measurement update and the ambiguity
+// resolution address them by index(key), which stays valid until the next add() or remove().
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/satellite.hpp"
+
+namespace canyon::rtk {
+
+/// The key of a keyed state: (satellite, frequency rank) for an ambiguity, (satellite, kIonosphere) for the
+/// satellite's ionosphere. Ordered by satellite, then frequency.
+struct StateKey {
+  static constexpr int kIonosphere = -1;
+  core::SatelliteId sat;
+  int frequency = 0;
+
+  [[nodiscard]] bool ionosphere() const { return frequency == kIonosphere; }
+  friend bool operator==(const StateKey& a, const StateKey& b) = default;
+  // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads a defaulted operator<=>
+  friend auto operator<=>(const StateKey& a, const StateKey& b) = default;
+};
+
+/// The layout of the unkeyed blocks.
+struct StateLayout {
+  bool kinematics = false;  ///< velocity and acceleration (the constant-acceleration model)
+  bool heading = false;     ///< the external aiding's heading error
+};
+
+class FilterState {
+ public:
+  static constexpr int kPosition = 0;  ///< index of the position block
+
+  explicit FilterState(StateLayout layout = {});
+
+  // ---- layout ----
+  [[nodiscard]] const StateLayout& layout() const { return layout_; }
+  /// Size of x (and of P's sides).
+  [[nodiscard]] Eigen::Index size() const { return x_.size(); }
+  /// Index of the velocity block (3), then the acceleration block (3); -1 without kinematics.
+  [[nodiscard]] int kinematics_index() const { return layout_.kinematics ? 3 : -1; }
+  /// Index of the heading error; -1 without a heading state.
+  [[nodiscard]] int heading_index() const { return layout_.heading ? (layout_.kinematics ? 9 : 3) : -1; }
+  /// Number of unkeyed states (position, kinematics, heading): the index of the first keyed state.
+  [[nodiscard]] int num_unkeyed() const { return 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0); }
+
+  // ---- keyed states ----
+  /// Index of a keyed state in x, -1 if absent.
+  [[nodiscard]] int index(const StateKey& key) const;
+  [[nodiscard]] bool has(const StateKey& key) const { return index(key) >= 0; }
+  /// The key of the keyed state at `index` (>= num_unkeyed()).
+  [[nodiscard]] const StateKey& key_at(int index) const;
+  [[nodiscard]] const std::vector<StateKey>& keys() const { return keys_; }
+  /// A keyed state to append: its initial value and variance, uncorrelated with every other state.
+  struct NewState {
+    StateKey key;
+    double value = 0.0;
+    double variance = 0.0;
+  };
+  /// Appends the states in order (one resize of x and P for all of them).
+  void add(const std::vector<NewState>& states);
+  /// Removes a keyed state (no-op if absent).
+  void remove(const StateKey& key);
+  /// Removes every keyed state.
+  void clear_keyed();
+
+  // ---- values ----
+  [[nodiscard]] const Eigen::VectorXd& x() const { return x_; }
+  [[nodiscard]] const Eigen::MatrixXd& P() const { return P_; }
+  [[nodiscard]] Eigen::Vector3d position_E_m() const { return x_.head<3>(); }
+  [[nodiscard]] Eigen::Matrix3d position_covariance_E_m2() const { return P_.topLeftCorner<3, 3>(); }
+
+  // ---- propagation (time update) ----
+  /// Sets the position (and, with kinematics, velocity and acceleration), uncorrelated with every other state: the
+  /// unkeyed block's rows and columns are cleared first. `var_position_m2` on the position's diagonal,
+  /// `var_kinematics` on the velocity's and acceleration's.
+  void reset_kinematics(const Eigen::Vector3d& p_E_m, const Eigen::Vector3d& v_E_mps, double var_position_m2,
+                        double var_kinematics);
+  /// x_k' = F_k x_k and P' = F P F^T for a transition F that is the identity but for its 9 x 9 kinematic block F_k
+  /// (position, velocity, acceleration; needs kinematics).
+  void propagate_kinematics(const Eigen::Matrix<double, 9, 9>& F_k);
+  /// The acceleration's process noise: P_aa += R_EN Q_N R_EN^T for Q_N given in local ENU (R_EN: ENU -> ECEF).
+  void add_acceleration_noise(const Eigen::Matrix3d& R_EN, const Eigen::Matrix3d& Q_N);
+  /// An external motion as the model: p += dp, P_pp += sym(Q); the position's correlations with the other states
+  /// are kept (dp does not depend on x).
+  void add_position_increment(const Eigen::Vector3d& dp_E_m, const Eigen::Matrix3d& Q_E_m2);
+  /// Adds q_ambiguity to every ambiguity's variance and q_ionosphere to every ionosphere state's.
+  void add_keyed_random_walk(double q_ambiguity, double q_ionosphere);
+  /// Restarts the heading error: value 0, variance `variance_rad2`, uncorrelated.
+  void restart_heading(double variance_rad2);
+  /// The heading error's share of the position: p += J psi, P = F P F^T with F = I + J e_psi^T, then psi's
+  /// variance grows by `noise_rad2`.
+  void couple_heading(const Eigen::Vector3d& J, double noise_rad2);
+  /// Sets the heading error's value (its variance and correlations kept).
+  void set_heading(double psi_rad) { x_[heading_index()] = psi_rad; }
+  /// Sets the position, uncorrelated with every other state.
+  void set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2);
+
+  // ---- measurement update ----
+  /// x += dx and P <- sym(P) - U V^T (U V^T symmetric, n x r each), P exactly symmetric afterwards.
+  void correct(const Eigen::VectorXd& dx, const Eigen::MatrixXd& U, const Eigen::MatrixXd& V);
+  /// x -= A b, P -= A B, then P symmetrised: conditioning the state on linear functions of it (fix and hold: A = P D^T,
+  /// b = S^-1 (a_float - a_fix), B = S^-1 D P).
+  void condition(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::MatrixXd& B);
+
+  // ---- snapshot ----
+  struct Snapshot {
+    Eigen::VectorXd x;
+    Eigen::MatrixXd P;
+    std::vector<StateKey> keys;
+  };
+  [[nodiscard]] Snapshot snapshot() const { return {x_, P_, keys_}; }
+  /// Back to a snapshot taken with the same keys (the caller keeps them unchanged in between).
+  void revert(const Snapshot& s);
+  /// Only x and P back to a snapshot of the same layout and keys (a retried update).
+  void restore_values(const Eigen::VectorXd& x, const Eigen::MatrixXd& P) {
+    x_ = x;
+    P_ = P;
+  }
+
+ private:
+  StateLayout layout_;
+  Eigen::VectorXd x_;
+  Eigen::MatrixXd P_;
+  std::vector<StateKey> keys_;  // keyed state i is at index num_unkeyed() + i
+};
+
+}  // namespace canyon::rtk

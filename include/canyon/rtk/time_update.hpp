@@ -1,0 +1,47 @@
+#pragma once
+// The RTK filter's time update (prediction), between two epochs dt_s apart.
+//
+// Own motion model (no external aiding): without dynamics (RTKLIB's "dynamics off") the position is re-initialised
+// each epoch from the single-point solution with variance initial_position_sigma_m^2, uncorrelated with the other
+// states; with dynamics a constant-acceleration model with white jerk:
+//   x_k' = F_k x_k,  F_k = [I dt I dt^2/2 I; 0 I dt I; 0 0 I],  P' = F P F^T + Q,
+//   Q on the acceleration: R_EN diag(sh^2, sh^2, sv^2) dt R_EN^T (sh, sv: accel_sigma_h_mps2, accel_sigma_v_mps2),
+// re-initialised (velocity from the single point's Doppler) after a gap of more than 30 s.
+// External motion (ExternalMotion, e.g. the fusion's VIO increment, fusion/vio_prediction.hpp): the increment and
+// its covariance are the model, p += dp, P_pp += Q, the position's correlations with the ambiguities kept. With a
+// heading state, psi (the error of the aiding frame's heading) rotates the increment about the local vertical:
+// p += dp + J psi with J = dp_d_heading_E_m (= up x dp), P' = F P F^T with F = I + J e_psi^T, and psi walks by
+// heading_noise_rad2; it restarts (value 0, variance heading_variance_rad2, uncorrelated) when the aiding asks and
+// after any epoch that was not aided.
+// Either way the ambiguities and ionosphere states are random walks: ambiguity_noise_cyc^2 dt, iono_noise_m^2 dt.
+
+#include <Eigen/Core>
+
+#include "canyon/gnss/spp.hpp"
+#include "canyon/rtk/filter_state.hpp"
+#include "canyon/rtk/rtk_options.hpp"
+
+namespace canyon::rtk {
+
+/// One epoch's motion from an external sensor (see above).
+struct ExternalMotion {
+  Eigen::Vector3d delta_p_E_m = Eigen::Vector3d::Zero();  ///< position increment since the state's last epoch (m)
+  Eigen::Matrix3d Q_E_m2 = Eigen::Matrix3d::Zero();       ///< its covariance, added to the position's (m^2)
+  // With RtkOptions::aiding_heading_state only:
+  Eigen::Vector3d dp_d_heading_E_m = Eigen::Vector3d::Zero();  ///< d(delta_p) / d(heading error): up x delta_p (m/rad)
+  double heading_noise_rad2 = 0.0;     ///< random walk of the heading error over this increment (rad^2)
+  double heading_variance_rad2 = 0.0;  ///< variance of the heading error when its state (re)starts (rad^2)
+  bool restart_heading = false;        ///< the aiding frame changed (a new alignment): restart the heading state
+};
+
+/// The own motion model over dt_s; `reinitialise` (no estimate yet) starts the position from `spp`.
+void own_motion_update(FilterState& state, const RtkOptions& options, double dt_s, bool reinitialise,
+                       const gnss::SppSolution& spp);
+
+/// The external motion; `heading_live` (the heading state holds an estimate) is read and set.
+void external_motion_update(FilterState& state, const ExternalMotion& motion, bool& heading_live);
+
+/// The random walks of the keyed states over dt_s.
+void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_s);
+
+}  // namespace canyon::rtk

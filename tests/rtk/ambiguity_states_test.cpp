@@ -1,0 +1,67 @@
+// The keyed states' bookkeeping (rtk/ambiguity_states.hpp): a new ambiguity starts at (phase - code) / lambda with
+// the initial sigma, becomes fixable after min_lock_epochs above the AR mask, never with a half cycle or a GLONASS
+// signal without glonass_ar; a state unseen for longer than the outage limit is stale; ionosphere states come with
+// the given prior sigma.
+
+#include "canyon/rtk/ambiguity_states.hpp"
+
+#include <gtest/gtest.h>
+
+#include "synthetic_epoch.hpp"
+
+namespace canyon::rtk {
+namespace {
+
+core::GpsTime at(double tow_s) {
+  return core::GpsTime{2200, tow_s};
+}
+
+TEST(AmbiguityStates, NewAmbiguitiesStartFromTheCodeAndBecomeFixableAfterTheirLockEpochs) {
+  testing::SyntheticEpoch e = testing::synthetic_epoch(4, Eigen::Vector3d::Zero(), 1.0, 1.0,
+                                                       [](int, int integer) { return static_cast<double>(integer); });
+  FilterState state({false, false});
+  RtkOptions o;
+  o.min_lock_epochs = 2;
+  o.ar_elevation_mask_rad = 0.5;  // the last satellite (25 deg) is below
+  e.sds[1].lli = core::kLliHalfCycle;
+  AmbiguityStates book;
+  const SlipScan no_slips;
+  const auto added = book.admit(e.sds, state, at(100.0), no_slips, o, std::nullopt);
+  ASSERT_EQ(added.size(), 4U);
+  EXPECT_NEAR(added[2].value, e.integers[2], 1e-9);  // (phase - code) / lambda at zero range
+  EXPECT_DOUBLE_EQ(added[2].variance, o.initial_ambiguity_sigma_cyc * o.initial_ambiguity_sigma_cyc);
+  state.add(added);
+  for (int epoch = 1; epoch <= 3; ++epoch) {
+    EXPECT_TRUE(book.admit(e.sds, state, at(100.0 + epoch), no_slips, o, std::nullopt).empty());
+    EXPECT_EQ(e.sds[0].fixable, epoch >= 2) << epoch;  // tracked for more than 2 epochs
+  }
+  EXPECT_FALSE(e.sds[1].fixable);  // half cycle
+  EXPECT_FALSE(e.sds[3].fixable);  // below the AR mask
+  assign_state_indices(e.sds, state);
+  EXPECT_EQ(e.sds[2].ambiguity, state.index({e.sds[2].sat, 0}));
+  EXPECT_EQ(e.sds[2].iono, -1);
+  // GLONASS without glonass_ar is never fixable.
+  e.sds[0].sat.system = core::Constellation::Glonass;
+  (void)book.admit(e.sds, state, at(104.0), no_slips, o, std::nullopt);
+  EXPECT_FALSE(e.sds[0].fixable);
+}
+
+TEST(AmbiguityStates, StaleAfterAnOutageAndIonosphereStatesWithTheirPrior) {
+  testing::SyntheticEpoch e = testing::synthetic_epoch(3, Eigen::Vector3d::Zero(), 1.0, 1.0,
+                                                       [](int, int integer) { return static_cast<double>(integer); });
+  FilterState state({false, false});
+  AmbiguityStates book;
+  const SlipScan no_slips;
+  const auto added = book.admit(e.sds, state, at(10.0), no_slips, RtkOptions{}, 0.05);
+  ASSERT_EQ(added.size(), 6U);  // three ambiguities, then three ionosphere states
+  EXPECT_TRUE(added[3].key.ionosphere());
+  EXPECT_DOUBLE_EQ(added[3].variance, 0.05 * 0.05);
+  state.add(added);
+  EXPECT_TRUE(book.stale(at(14.0), 5.0).empty());
+  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 6U);
+  book.forget(added[0].key);
+  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 5U);
+}
+
+}  // namespace
+}  // namespace canyon::rtk
