@@ -3,65 +3,11 @@
 #include "canyon/rtk/kalman.hpp"
 
 #include <algorithm>
-#include <cmath>
+
+#include <Eigen/Cholesky>
 
 namespace canyon::rtk {
 namespace {
-
-/// In-place Cholesky factorisation A = L L^T of a symmetric positive definite m x m matrix given by its lower
-/// triangle; L overwrites the lower triangle, the strict upper triangle is neither read nor written. False if A is
-/// not positive definite.
-bool cholesky_lower_in_place(Eigen::MatrixXd& A) {
-  const Eigen::Index m = A.rows();
-  double* a = A.data();
-  for (Eigen::Index j = 0; j < m; ++j) {
-    // Left looking: column j minus the contributions of the columns already factorised, four at a time (one pass
-    // over column j per four), then scaled.
-    double* a_j = a + j * m;
-    Eigen::Index k = 0;
-    for (; k + 4 <= j; k += 4) {
-      const double* a_0 = a + k * m;
-      const double* a_1 = a_0 + m;
-      const double* a_2 = a_1 + m;
-      const double* a_3 = a_2 + m;
-      const double l_0 = a_0[j], l_1 = a_1[j], l_2 = a_2[j], l_3 = a_3[j];
-      for (Eigen::Index i = j; i < m; ++i) a_j[i] -= (l_0 * a_0[i] + l_1 * a_1[i]) + (l_2 * a_2[i] + l_3 * a_3[i]);
-    }
-    for (; k < j; ++k) {
-      const double* a_k = a + k * m;
-      const double l_jk = a_k[j];
-      for (Eigen::Index i = j; i < m; ++i) a_j[i] -= l_jk * a_k[i];
-    }
-    if (!(a_j[j] > 0.0)) return false;
-    const double l_jj = std::sqrt(a_j[j]);
-    a_j[j] = l_jj;
-    for (Eigen::Index i = j + 1; i < m; ++i) a_j[i] /= l_jj;
-  }
-  return true;
-}
-
-/// B <- L^-1 B in place (L lower triangular m x m, in the lower triangle of L; B m x k).
-template <typename Derived>
-void solve_lower_in_place(const Eigen::MatrixXd& L, Eigen::MatrixBase<Derived>& B) {
-  const Eigen::Index m = L.rows();
-  for (Eigen::Index j = 0; j < B.cols(); ++j) {
-    auto b = B.col(j);
-    for (Eigen::Index k = 0; k < m; ++k) {
-      const double y_k = b[k] / L(k, k);
-      b[k] = y_k;
-      b.tail(m - k - 1) -= y_k * L.col(k).tail(m - k - 1);
-    }
-  }
-}
-
-/// X <- X L^-T in place (X n x m, L lower triangular m x m): column k of the result is
-/// (X_k - sum_{j<k} L_kj X_j) / L_kk, one matrix-vector product per column.
-void solve_transposed_lower_from_right_in_place(const Eigen::MatrixXd& L, Eigen::MatrixXd& X) {
-  for (Eigen::Index k = 0; k < X.cols(); ++k) {
-    if (k > 0) X.col(k).noalias() -= X.leftCols(k) * L.row(k).head(k).transpose();
-    X.col(k) /= L(k, k);
-  }
-}
 
 /// The states a block of DD rows touches, ascending, and the rows' Jacobian on them (H = H_J on J, zero elsewhere).
 struct CompressedJacobian {
@@ -111,10 +57,11 @@ std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P, const std:
   for (Eigen::Index b = 0; b < m; ++b) {
     for (Eigen::Index a = b; a < m; ++a) S(a, b) = H_P_JJ.row(a).dot(c.H_J.row(b)) + R(a, b);
   }
-  if (!cholesky_lower_in_place(S)) return std::nullopt;
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(S);  // in place, from the lower triangle
+  if (llt.info() != Eigen::Success) return std::nullopt;
   Eigen::MatrixXd G = c.H_J;
-  solve_lower_in_place(S, G);
-  solve_lower_in_place(S, v);
+  llt.matrixL().solveInPlace(G);
+  llt.matrixL().solveInPlace(v);
   step.dx = step.V * (G.transpose() * v);
   step.U = step.V.lazyProduct(G.transpose().lazyProduct(G));
   return step;
@@ -135,9 +82,10 @@ std::optional<KalmanStep> dense_update(const Eigen::MatrixXd& P, const KalmanSte
   for (Eigen::Index b = 0; b < m; ++b) {
     for (Eigen::Index a = b; a < m; ++a) S(a, b) = rows[static_cast<std::size_t>(a)]->dot(step.U.col(b)) + R(a, b);
   }
-  if (!cholesky_lower_in_place(S)) return std::nullopt;
-  solve_transposed_lower_from_right_in_place(S, step.U);
-  solve_lower_in_place(S, v);
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(S);  // in place, from the lower triangle
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  llt.matrixU().solveInPlace<Eigen::OnTheRight>(step.U);  // U L^-T
+  llt.matrixL().solveInPlace(v);
   step.dx = step.U * v;
   step.V = step.U;
   return step;
