@@ -362,4 +362,248 @@ constexpr void glonass_bias_fields(Io& io, Biases& b, Wire& w) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// Ephemerides. Angles are in semicircles (Unit::Semicircle converts with kGpsPi).
+
+/// Kepler ephemeris values that KeplerEphemeris holds otherwise (or not at all).
+struct KeplerWire {
+  int number = 0;        ///< DF002: 1019, 1042, 1044, 1045, 1046
+  int prn = 0;           ///< satellite id
+  int week = 0;          ///< week as sent: modulo 1024 (GPS, QZSS), 8192 (BeiDou), 4096 (Galileo)
+  int accuracy = 0;      ///< URA index (GPS, QZSS, BeiDou), SISA index (Galileo)
+  int l2_codes = 0;      ///< GPS DF078, QZSS DF451: KeplerEphemeris::data_source & 3
+  double toc_s = 0.0;    ///< clock reference time, seconds of the system's week
+  int fit_interval = 0;  ///< GPS DF137, QZSS DF457: 1 = longer than 4 hours
+  int health = 0;        ///< BeiDou DF515 SatH1
+  int e5a_health = 0;    ///< Galileo DF314 E5a signal health status
+  int e5a_validity = 0;  ///< DF315 E5a data validity status
+  int e5b_health = 0;    ///< DF316
+  int e5b_validity = 0;  ///< DF317
+  int e1b_health = 0;    ///< DF287
+  int e1b_validity = 0;  ///< DF288
+};
+
+/// 1019 GPS ephemeris, 488 bits.
+template <class Io, class Eph, class Wire>
+constexpr void gps_ephemeris_fields(Io& io, Eph& e, Wire& w) {
+  constexpr Unit kSc = Unit::Semicircle;
+  io(u(2, 12), w.number);                                       // DF002 message number
+  io(u(9, 6, "satellite id"), w.prn);                           // DF009 satellite id
+  io(u(76, 10), w.week);                                        // DF076 week number
+  io(u(77, 4, "URA"), w.accuracy);                              // DF077 SV accuracy (URA index)
+  io(u(78, 2), w.l2_codes);                                     // DF078 code on L2
+  io(s(79, 14, p2(-43), "IDOT", kSc), e.idot_radps);            // DF079 IDOT
+  io(u(71, 8, "IODE"), e.iode);                                 // DF071 IODE
+  io(u(81, 16, 16.0, "toc"), w.toc_s);                          // DF081 toc, s
+  io(s(82, 8, p2(-55), "af2"), e.af2_sps2);                     // DF082 af2
+  io(s(83, 16, p2(-43), "af1"), e.af1_sps);                     // DF083 af1
+  io(s(84, 22, p2(-31), "af0"), e.af0_s);                       // DF084 af0
+  io(u(85, 10, "IODC"), e.iodc);                                // DF085 IODC
+  io(s(86, 16, p2(-5), "Crs"), e.crs_m);                        // DF086 Crs
+  io(s(87, 16, p2(-43), "delta n", kSc), e.delta_n_radps);      // DF087 delta n
+  io(s(88, 32, p2(-31), "M0", kSc), e.m0_rad);                  // DF088 M0
+  io(s(89, 16, p2(-29), "Cuc"), e.cuc_rad);                     // DF089 Cuc
+  io(u(90, 32, p2(-33), "e"), e.e);                             // DF090 eccentricity
+  io(s(91, 16, p2(-29), "Cus"), e.cus_rad);                     // DF091 Cus
+  io(u(92, 32, p2(-19), "sqrt A"), e.sqrt_a_sqrtm);             // DF092 sqrt A
+  io(u(93, 16, 16.0, "toe"), e.toe_sow_s);                      // DF093 toe, s
+  io(s(94, 16, p2(-29), "Cic"), e.cic_rad);                     // DF094 Cic
+  io(s(95, 32, p2(-31), "OMEGA0", kSc), e.omega0_rad);          // DF095 OMEGA0
+  io(s(96, 16, p2(-29), "Cis"), e.cis_rad);                     // DF096 Cis
+  io(s(97, 32, p2(-31), "i0", kSc), e.i0_rad);                  // DF097 i0
+  io(s(98, 16, p2(-5), "Crc"), e.crc_m);                        // DF098 Crc
+  io(s(99, 32, p2(-31), "omega", kSc), e.omega_rad);            // DF099 omega
+  io(s(100, 24, p2(-43), "OMEGADOT", kSc), e.omega_dot_radps);  // DF100 OMEGADOT
+  io(s(101, 8, p2(-31), "TGD"), e.tgd_s[0]);                    // DF101 tGD
+  io(u(102, 6, "health"), e.health);                            // DF102 SV health
+  io(unused(103, 1));                                           // DF103 L2 P data flag
+  io(u(137, 1), w.fit_interval);                                // DF137 fit interval
+}
+
+/// 1044 QZSS ephemeris, 485 bits.
+template <class Io, class Eph, class Wire>
+constexpr void qzss_ephemeris_fields(Io& io, Eph& e, Wire& w) {
+  constexpr Unit kSc = Unit::Semicircle;
+  io(u(2, 12), w.number);                                       // DF002 message number
+  io(u(429, 4, "satellite id"), w.prn);                         // DF429 satellite id
+  io(u(430, 16, 16.0, "toc"), w.toc_s);                         // DF430 toc, s
+  io(s(431, 8, p2(-55), "af2"), e.af2_sps2);                    // DF431 af2
+  io(s(432, 16, p2(-43), "af1"), e.af1_sps);                    // DF432 af1
+  io(s(433, 22, p2(-31), "af0"), e.af0_s);                      // DF433 af0
+  io(u(434, 8, "IODE"), e.iode);                                // DF434 IODE
+  io(s(435, 16, p2(-5), "Crs"), e.crs_m);                       // DF435 Crs
+  io(s(436, 16, p2(-43), "delta n", kSc), e.delta_n_radps);     // DF436 delta n
+  io(s(437, 32, p2(-31), "M0", kSc), e.m0_rad);                 // DF437 M0
+  io(s(438, 16, p2(-29), "Cuc"), e.cuc_rad);                    // DF438 Cuc
+  io(u(439, 32, p2(-33), "e"), e.e);                            // DF439 eccentricity
+  io(s(440, 16, p2(-29), "Cus"), e.cus_rad);                    // DF440 Cus
+  io(u(441, 32, p2(-19), "sqrt A"), e.sqrt_a_sqrtm);            // DF441 sqrt A
+  io(u(442, 16, 16.0, "toe"), e.toe_sow_s);                     // DF442 toe, s
+  io(s(443, 16, p2(-29), "Cic"), e.cic_rad);                    // DF443 Cic
+  io(s(444, 32, p2(-31), "OMEGA0", kSc), e.omega0_rad);         // DF444 OMEGA0
+  io(s(445, 16, p2(-29), "Cis"), e.cis_rad);                    // DF445 Cis
+  io(s(446, 32, p2(-31), "i0", kSc), e.i0_rad);                 // DF446 i0
+  io(s(447, 16, p2(-5), "Crc"), e.crc_m);                       // DF447 Crc
+  io(s(448, 32, p2(-31), "omega", kSc), e.omega_rad);           // DF448 omega
+  io(s(449, 24, p2(-43), "OMEGADOT", kSc), e.omega_dot_radps);  // DF449 OMEGADOT
+  io(s(450, 14, p2(-43), "IDOT", kSc), e.idot_radps);           // DF450 IDOT
+  io(u(451, 2), w.l2_codes);                                    // DF451 codes on L2
+  io(u(452, 10), w.week);                                       // DF452 week number
+  io(u(453, 4, "URA"), w.accuracy);                             // DF453 URA index
+  io(u(454, 6, "health"), e.health);                            // DF454 SV health
+  io(s(455, 8, p2(-31), "TGD"), e.tgd_s[0]);                    // DF455 tGD
+  io(u(456, 10, "IODC"), e.iodc);                               // DF456 IODC
+  io(u(457, 1), w.fit_interval);                                // DF457 fit interval
+}
+
+/// 1042 BeiDou ephemeris, 511 bits. Times in BDT.
+template <class Io, class Eph, class Wire>
+constexpr void beidou_ephemeris_fields(Io& io, Eph& e, Wire& w) {
+  constexpr Unit kSc = Unit::Semicircle;
+  io(u(2, 12), w.number);                                       // DF002 message number
+  io(u(488, 6, "satellite id"), w.prn);                         // DF488 satellite id
+  io(u(489, 13), w.week);                                       // DF489 week number
+  io(u(490, 4, "URAI"), w.accuracy);                            // DF490 URA index
+  io(s(491, 14, p2(-43), "IDOT", kSc), e.idot_radps);           // DF491 IDOT
+  io(u(492, 5, "AODE"), e.iode);                                // DF492 AODE
+  io(u(493, 17, 8.0, "toc"), w.toc_s);                          // DF493 toc, s
+  io(s(494, 11, p2(-66), "a2"), e.af2_sps2);                    // DF494 a2
+  io(s(495, 22, p2(-50), "a1"), e.af1_sps);                     // DF495 a1
+  io(s(496, 24, p2(-33), "a0"), e.af0_s);                       // DF496 a0
+  io(u(497, 5, "AODC"), e.iodc);                                // DF497 AODC
+  io(s(498, 18, p2(-6), "Crs"), e.crs_m);                       // DF498 Crs
+  io(s(499, 16, p2(-43), "delta n", kSc), e.delta_n_radps);     // DF499 delta n
+  io(s(500, 32, p2(-31), "M0", kSc), e.m0_rad);                 // DF500 M0
+  io(s(501, 18, p2(-31), "Cuc"), e.cuc_rad);                    // DF501 Cuc
+  io(u(502, 32, p2(-33), "e"), e.e);                            // DF502 eccentricity
+  io(s(503, 18, p2(-31), "Cus"), e.cus_rad);                    // DF503 Cus
+  io(u(504, 32, p2(-19), "sqrt A"), e.sqrt_a_sqrtm);            // DF504 sqrt A
+  io(u(505, 17, 8.0, "toe"), e.toe_sow_s);                      // DF505 toe, s
+  io(s(506, 18, p2(-31), "Cic"), e.cic_rad);                    // DF506 Cic
+  io(s(507, 32, p2(-31), "OMEGA0", kSc), e.omega0_rad);         // DF507 OMEGA0
+  io(s(508, 18, p2(-31), "Cis"), e.cis_rad);                    // DF508 Cis
+  io(s(509, 32, p2(-31), "i0", kSc), e.i0_rad);                 // DF509 i0
+  io(s(510, 18, p2(-6), "Crc"), e.crc_m);                       // DF510 Crc
+  io(s(511, 32, p2(-31), "omega", kSc), e.omega_rad);           // DF511 omega
+  io(s(512, 24, p2(-43), "OMEGADOT", kSc), e.omega_dot_radps);  // DF512 OMEGADOT
+  io(s(513, 10, 1e-10, "TGD1"), e.tgd_s[0]);                    // DF513 TGD1, s
+  io(s(514, 10, 1e-10, "TGD2"), e.tgd_s[1]);                    // DF514 TGD2, s
+  io(u(515, 1, "health"), w.health);                            // DF515 SatH1
+}
+
+/// 1045 Galileo F/NAV (496 bits) and 1046 I/NAV (504 bits) ephemerides.
+template <class Io, class Eph, class Wire>
+constexpr void galileo_ephemeris_fields(Io& io, Eph& e, Wire& w) {
+  constexpr Unit kSc = Unit::Semicircle;
+  io(u(2, 12), w.number);                                       // DF002 message number
+  io(u(252, 6, "satellite id"), w.prn);                         // DF252 satellite id
+  io(u(289, 12), w.week);                                       // DF289 week number
+  io(u(290, 10, "IODnav"), e.iode);                             // DF290 IODnav
+  io(u(291, 8, "SISA"), w.accuracy);                            // DF291 SISA index
+  io(s(292, 14, p2(-43), "IDOT", kSc), e.idot_radps);           // DF292 IDOT
+  io(u(293, 14, 60.0, "toc"), w.toc_s);                         // DF293 toc, s
+  io(s(294, 6, p2(-59), "af2"), e.af2_sps2);                    // DF294 af2
+  io(s(295, 21, p2(-46), "af1"), e.af1_sps);                    // DF295 af1
+  io(s(296, 31, p2(-34), "af0"), e.af0_s);                      // DF296 af0
+  io(s(297, 16, p2(-5), "Crs"), e.crs_m);                       // DF297 Crs
+  io(s(298, 16, p2(-43), "delta n", kSc), e.delta_n_radps);     // DF298 delta n
+  io(s(299, 32, p2(-31), "M0", kSc), e.m0_rad);                 // DF299 M0
+  io(s(300, 16, p2(-29), "Cuc"), e.cuc_rad);                    // DF300 Cuc
+  io(u(301, 32, p2(-33), "e"), e.e);                            // DF301 eccentricity
+  io(s(302, 16, p2(-29), "Cus"), e.cus_rad);                    // DF302 Cus
+  io(u(303, 32, p2(-19), "sqrt A"), e.sqrt_a_sqrtm);            // DF303 sqrt A
+  io(u(304, 14, 60.0, "toe"), e.toe_sow_s);                     // DF304 toe, s
+  io(s(305, 16, p2(-29), "Cic"), e.cic_rad);                    // DF305 Cic
+  io(s(306, 32, p2(-31), "OMEGA0", kSc), e.omega0_rad);         // DF306 OMEGA0
+  io(s(307, 16, p2(-29), "Cis"), e.cis_rad);                    // DF307 Cis
+  io(s(308, 32, p2(-31), "i0", kSc), e.i0_rad);                 // DF308 i0
+  io(s(309, 16, p2(-5), "Crc"), e.crc_m);                       // DF309 Crc
+  io(s(310, 32, p2(-31), "omega", kSc), e.omega_rad);           // DF310 omega
+  io(s(311, 24, p2(-43), "OMEGADOT", kSc), e.omega_dot_radps);  // DF311 OMEGADOT
+  io(s(312, 10, p2(-32), "BGD E5a/E1"), e.tgd_s[0]);            // DF312 BGD E5a/E1, s
+  if (w.number == 1045) {
+    io(u(314, 2), w.e5a_health);    // DF314 E5a signal health status
+    io(u(315, 1), w.e5a_validity);  // DF315 E5a data validity status
+    io(reserved(7));                // DF001 reserved
+  } else {
+    io(s(313, 10, p2(-32), "BGD E5b/E1"), e.tgd_s[1]);  // DF313 BGD E5b/E1, s
+    io(u(316, 2), w.e5b_health);                        // DF316 E5b signal health status
+    io(u(317, 1), w.e5b_validity);                      // DF317 E5b data validity status
+    io(u(287, 2), w.e1b_health);                        // DF287 E1-B signal health status
+    io(u(288, 1), w.e1b_validity);                      // DF288 E1-B data validity status
+    io(reserved(2));                                    // DF001 reserved
+  }
+}
+
+/// The layout of Kepler ephemeris message w.number; false if it is none.
+template <class Io, class Eph, class Wire>
+constexpr bool kepler_ephemeris_fields(Io& io, Eph& e, Wire& w) {
+  switch (w.number) {
+    case 1019: gps_ephemeris_fields(io, e, w); return true;
+    case 1044: qzss_ephemeris_fields(io, e, w); return true;
+    case 1042: beidou_ephemeris_fields(io, e, w); return true;
+    case 1045:
+    case 1046: galileo_ephemeris_fields(io, e, w); return true;
+    default: return false;
+  }
+}
+
+/// 1020 values that GlonassEphemeris holds otherwise.
+struct GlonassWire {
+  int slot = 0;            ///< DF038
+  int channel = 0;         ///< DF040: frequency channel + 7
+  long long tk_hours = 0;  ///< DF107 tk: hours, minutes, 30-second interval (Moscow time of day)
+  long long tk_minutes = 0;
+  long long tk_half_minute = 0;
+  int bn_msb = 0;            ///< DF108 MSB of Bn: unhealthy
+  long long tb_odd = 0;      ///< DF109 P2
+  long long tb = 0;          ///< DF110: 15-minute interval of the Moscow day
+  long long day_number = 0;  ///< DF129 N_T: day within the four-year period starting with a leap year
+};
+
+/// 1020 GLONASS ephemeris, 360 bits. Values in m, m/s, m/s^2 (sent in km).
+template <class Io, class Eph, class Wire>
+constexpr void glonass_ephemeris_fields(Io& io, Eph& g, Wire& w) {
+  constexpr Unit kKm = Unit::Kilometre;
+  io(unused(2, 12, 1020));                                      // DF002 message number
+  io(u(38, 6, "satellite id"), w.slot);                         // DF038 satellite id (slot)
+  io(u(40, 5, "frequency channel"), w.channel);                 // DF040 frequency channel number + 7
+  io(unused(104, 1));                                           // DF104 almanac health
+  io(unused(105, 1));                                           // DF105 almanac health availability indicator
+  io(unused(106, 2));                                           // DF106 P1
+  io(u(107, 5, "tk hours"), w.tk_hours);                        // DF107 tk: hours
+  io(u(107, 6, "tk minutes"), w.tk_minutes);                    //        minutes
+  io(u(107, 1, "tk 30 s"), w.tk_half_minute);                   //        30-second interval
+  io(u(108, 1), w.bn_msb);                                      // DF108 MSB of Bn
+  io(u(109, 1), w.tb_odd);                                      // DF109 P2
+  io(u(110, 7, "tb"), w.tb);                                    // DF110 tb
+  io(sm(111, 24, p2(-20), "velocity", kKm), g.v_E_mps[0]);      // DF111 xn'(tb), km/s
+  io(sm(112, 27, p2(-11), "position", kKm), g.p_E_m[0]);        // DF112 xn(tb), km
+  io(sm(113, 5, p2(-30), "acceleration", kKm), g.a_E_mps2[0]);  // DF113 xn''(tb), km/s^2
+  io(sm(114, 24, p2(-20), "velocity", kKm), g.v_E_mps[1]);      // DF114 yn'(tb)
+  io(sm(115, 27, p2(-11), "position", kKm), g.p_E_m[1]);        // DF115 yn(tb)
+  io(sm(116, 5, p2(-30), "acceleration", kKm), g.a_E_mps2[1]);  // DF116 yn''(tb)
+  io(sm(117, 24, p2(-20), "velocity", kKm), g.v_E_mps[2]);      // DF117 zn'(tb)
+  io(sm(118, 27, p2(-11), "position", kKm), g.p_E_m[2]);        // DF118 zn(tb)
+  io(sm(119, 5, p2(-30), "acceleration", kKm), g.a_E_mps2[2]);  // DF119 zn''(tb)
+  io(unused(120, 1));                                           // DF120 P3
+  io(sm(121, 11, p2(-40), "gamma_n"), g.gamma_n);               // DF121 gamma_n(tb)
+  io(unused(122, 2));                                           // DF122 P
+  io(unused(123, 1));                                           // DF123 ln (third string)
+  io(sm(124, 22, p2(-30), "tau_n", Unit::Negated), g.tau_n_s);  // DF124 tau_n(tb), s (canyon keeps -tau_n)
+  io(sm(125, 5, p2(-30), "delta tau_n"), g.delta_tau_n_s);      // DF125 delta tau_n, s
+  io(u(126, 5, "E_n"), g.age_days);                             // DF126 E_n, days
+  io(unused(127, 1));                                           // DF127 P4
+  io(unused(128, 4));                                           // DF128 F_T
+  io(u(129, 11, "N_T"), w.day_number);                          // DF129 N_T
+  io(unused(130, 2, 1));                                        // DF130 M: GLONASS-M
+  io(unused(131, 1));                                           // DF131 additional data (DF132-DF135) not valid
+  io(unused(132, 11));                                          // DF132 N^A
+  io(unused(133, 32));                                          // DF133 tau_c
+  io(unused(134, 5));                                           // DF134 N_4
+  io(unused(135, 22));                                          // DF135 tau_GPS
+  io(unused(136, 1));                                           // DF136 ln (fifth string)
+  io(reserved(7));                                              // DF001 reserved
+}
+
 }  // namespace canyon::io::rtcm3::fields
