@@ -606,4 +606,83 @@ constexpr void glonass_ephemeris_fields(Io& io, Eph& g, Wire& w) {
   io(reserved(7));                                              // DF001 reserved
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// Legacy observations (decode only): 1004 GPS and 1012 GLONASS extended L1&L2 RTK observables.
+
+inline constexpr double kLegacyPseudorangeLsbM = 0.02;  // DF011, DF017, DF041, DF047
+inline constexpr double kLegacyPhaseLsbM = 0.0005;      // DF012, DF018, DF042, DF048
+inline constexpr double kLegacyCnrLsbDbhz = 0.25;       // DF015, DF020, DF045, DF050
+
+/// Header values that LegacyObsMessage holds otherwise.
+struct LegacyWire {
+  int number = 0;
+  int satellites = 0;  ///< DF006 / DF035
+};
+
+/// Header of 1004 (64 bits) and 1012 (61 bits).
+template <class Io, class Message, class Wire>
+constexpr void legacy_header_fields(Io& io, Message& m, Wire& w) {
+  const bool glonass = w.number == 1012;
+  io(u(2, 12), w.number);                            // DF002 message number
+  io(u(3, 12), m.station_id);                        // DF003 reference station id
+  io(glonass ? u(34, 27) : u(4, 30), m.epoch_time);  // DF034 GLONASS epoch time / DF004 GPS epoch time, ms
+  io(u(5, 1), m.synchronous);                        // DF005 synchronous GNSS flag
+  io(glonass ? u(35, 5) : u(6, 5), w.satellites);    // DF035 / DF006 number of satellites
+  io(glonass ? unused(36, 1) : unused(7, 1));        // DF036 / DF007 divergence-free smoothing indicator
+  io(glonass ? unused(37, 3) : unused(8, 3));        // DF037 / DF008 smoothing interval
+}
+
+/// One satellite of 1004 or 1012 as sent.
+struct LegacySatelliteWire {
+  int id = 0;                       ///< DF009 / DF038
+  int l1_code = 0;                  ///< DF010 / DF039
+  int channel = 0;                  ///< DF040: frequency channel + 7 (1012)
+  double l1_pseudorange_m = 0.0;    ///< DF011 / DF041, modulo the ambiguity
+  std::int64_t l1_phase = 0;        ///< DF012 / DF042: L1 phase range - L1 pseudorange (-2^19: invalid)
+  int l1_lock = 0;                  ///< DF013 / DF043
+  double ambiguity_m = 0.0;         ///< DF014 / DF044
+  int l1_cnr = 0;                   ///< DF015 / DF045 (0: not given)
+  int l2_code = 0;                  ///< DF016 / DF046
+  std::int64_t l2_pseudorange = 0;  ///< DF017 / DF047: L2 - L1 pseudorange (-2^13: invalid)
+  std::int64_t l2_phase = 0;        ///< DF018 / DF048: L2 phase range - L1 pseudorange (-2^19: invalid)
+  int l2_lock = 0;                  ///< DF019 / DF049
+  int l2_cnr = 0;                   ///< DF020 / DF050
+};
+
+/// One satellite of 1004 (125 bits) or 1012 (130 bits).
+template <class Io, class Sat>
+constexpr void legacy_satellite_fields(Io& io, bool glonass, Sat& sat) {
+  constexpr double kPr = kLegacyPseudorangeLsbM;
+  constexpr double kPhase = kLegacyPhaseLsbM;
+  constexpr double kCnr = kLegacyCnrLsbDbhz;
+  if (glonass) {
+    io(u(38, 6), sat.id);                       // DF038 satellite id (slot)
+    io(u(39, 1), sat.l1_code);                  // DF039 L1 code indicator
+    io(u(40, 5), sat.channel);                  // DF040 frequency channel number + 7
+    io(u(41, 25, kPr), sat.l1_pseudorange_m);   // DF041 L1 pseudorange, m
+    io(s(42, 20, kPhase), sat.l1_phase);        // DF042 L1 phase range - L1 pseudorange
+    io(u(43, 7), sat.l1_lock);                  // DF043 L1 lock time indicator
+    io(u(44, 7, 599584.916), sat.ambiguity_m);  // DF044 L1 pseudorange modulus ambiguity, m
+    io(u(45, 8, kCnr), sat.l1_cnr);             // DF045 L1 CNR
+    io(u(46, 2), sat.l2_code);                  // DF046 L2 code indicator
+    io(s(47, 14, kPr), sat.l2_pseudorange);     // DF047 L2 - L1 pseudorange difference
+    io(s(48, 20, kPhase), sat.l2_phase);        // DF048 L2 phase range - L1 pseudorange
+    io(u(49, 7), sat.l2_lock);                  // DF049 L2 lock time indicator
+    io(u(50, 8, kCnr), sat.l2_cnr);             // DF050 L2 CNR
+  } else {
+    io(u(9, 6), sat.id);                        // DF009 satellite id
+    io(u(10, 1), sat.l1_code);                  // DF010 L1 code indicator
+    io(u(11, 24, kPr), sat.l1_pseudorange_m);   // DF011 L1 pseudorange, m
+    io(s(12, 20, kPhase), sat.l1_phase);        // DF012 L1 phase range - L1 pseudorange
+    io(u(13, 7), sat.l1_lock);                  // DF013 L1 lock time indicator
+    io(u(14, 8, 299792.458), sat.ambiguity_m);  // DF014 L1 pseudorange modulus ambiguity, m
+    io(u(15, 8, kCnr), sat.l1_cnr);             // DF015 L1 CNR
+    io(u(16, 2), sat.l2_code);                  // DF016 L2 code indicator
+    io(s(17, 14, kPr), sat.l2_pseudorange);     // DF017 L2 - L1 pseudorange difference
+    io(s(18, 20, kPhase), sat.l2_phase);        // DF018 L2 phase range - L1 pseudorange
+    io(u(19, 7), sat.l2_lock);                  // DF019 L2 lock time indicator
+    io(u(20, 8, kCnr), sat.l2_cnr);             // DF020 L2 CNR
+  }
+}
+
 }  // namespace canyon::io::rtcm3::fields
