@@ -297,6 +297,144 @@ class FieldCounter {
 };
 
 // ---------------------------------------------------------------------------------------------------------------
+// Multiple Signal Messages (RTCM 10403.3 section 3.5.12): header, satellite data, signal data. Satellite and signal
+// data are sent field by field: one field for every satellite (or cell) in turn, then the next field.
+
+/// Message number and masks (DF394-DF396).
+struct MsmMasks {
+  int number = 0;
+  std::uint64_t satellites = 0;  ///< DF394, satellite id 1 in the most significant bit
+  std::uint32_t signals = 0;     ///< DF395, signal id 1 in the most significant bit
+  std::uint64_t cells = 0;       ///< DF396, nsat x nsig bits
+};
+
+/// The header, DF002 to DF395 (169 bits).
+template <class Io, class Header, class Masks>
+constexpr void msm_header_fields(Io& io, Header& h, Masks& masks) {
+  io(u(2, 12), masks.number);                  // DF002 message number
+  io(u(3, 12), h.station_id);                  // DF003 reference station id
+  io(u(4, 30), h.epoch_time);                  // DF004 / DF248 / DF427 / DF428 epoch time; DF416 + DF034 GLONASS
+  io(u(393, 1), h.multiple_message);           // DF393 multiple message bit
+  io(u(409, 3), h.iods);                       // DF409 issue of data station
+  io(reserved(7));                             // DF001 reserved
+  io(u(411, 2), h.clock_steering);             // DF411 clock steering indicator
+  io(u(412, 2), h.external_clock);             // DF412 external clock indicator
+  io(u(417, 1), h.divergence_free_smoothing);  // DF417 divergence-free smoothing indicator
+  io(u(418, 3), h.smoothing_interval);         // DF418 smoothing interval
+  io(u(394, 64), masks.satellites);            // DF394 satellite mask
+  io(u(395, 32), masks.signals);               // DF395 signal mask
+}
+
+/// DF396 cell mask, after the header: one bit per satellite x signal of the masks.
+template <class Io, class Masks>
+constexpr void msm_cell_mask_field(Io& io, Masks& masks) {
+  const int cells = std::popcount(masks.satellites) * std::popcount(masks.signals);
+  io(u(396, static_cast<unsigned>(cells)), masks.cells);
+}
+
+/// Satellite data as sent (raw field values), one per satellite.
+struct MsmSatelliteData {
+  std::uint32_t rough_range_ms;    ///< DF397 (255: invalid)
+  std::uint32_t info;              ///< DF419
+  std::uint32_t rough_range_frac;  ///< DF398
+  std::int32_t rough_rate;         ///< DF399 (-8192: invalid)
+};
+/// Signal data as sent (raw field values), one per cell.
+struct MsmSignalData {
+  std::int32_t pseudorange;  ///< DF400 / DF405 (most negative: invalid)
+  std::int32_t phase_range;  ///< DF401 / DF406 (most negative: invalid)
+  std::uint32_t lock_time;   ///< DF402 / DF407
+  bool half_cycle;           ///< DF420
+  std::uint32_t cnr;         ///< DF403 / DF408 (0: not given)
+  std::int32_t fine_rate;    ///< DF404 (-16384: invalid)
+};
+
+/// The satellite and signal data fields of an MSM type.
+struct MsmFields {
+  bool extended = false;         ///< MSM5, MSM7: extended satellite information and phase range rates
+  bool high_resolution = false;  ///< MSM6, MSM7
+  Field rough_range_ms;          ///< satellite data
+  Field info;                    ///< extended only
+  Field rough_range_frac;
+  Field rough_rate;   ///< extended only
+  Field pseudorange;  ///< signal data
+  Field phase_range;
+  Field lock_time;
+  Field half_cycle;
+  Field cnr;
+  Field fine_rate;                 ///< extended only
+  std::size_t satellite_bits = 0;  ///< per satellite
+  std::size_t cell_bits = 0;       ///< per cell
+};
+
+/// The fields of MSM type 4-7 (sizes: see kMsmFields).
+constexpr MsmFields make_msm_fields(int type) {
+  const bool high = type >= 6;
+  MsmFields f;
+  f.extended = type == 5 || type == 7;
+  f.high_resolution = high;
+  f.rough_range_ms = u(397, 8);                                      // DF397 rough range, whole ms
+  f.info = u(419, 4);                                                // DF419 extended satellite info
+  f.rough_range_frac = u(398, 10, p2(-10));                          // DF398 rough range modulo 1 ms
+  f.rough_rate = s(399, 14, 1.0);                                    // DF399 rough phase range rate, m/s
+  f.pseudorange = high ? s(405, 20, p2(-29)) : s(400, 15, p2(-24));  // DF405 / DF400 fine pseudorange, ms
+  f.phase_range = high ? s(406, 24, p2(-31)) : s(401, 22, p2(-29));  // DF406 / DF401 fine phase range, ms
+  f.lock_time = high ? u(407, 10) : u(402, 4);                       // DF407 / DF402 lock time indicator
+  f.half_cycle = u(420, 1);                                          // DF420 half-cycle ambiguity indicator
+  f.cnr = high ? u(408, 10, p2(-4)) : u(403, 6, 1.0);                // DF408 / DF403 CNR, dB-Hz
+  f.fine_rate = s(404, 15, 1e-4);                                    // DF404 fine phase range rate, m/s
+  return f;
+}
+
+/// Satellite data of `sats` (in satellite id order), then signal data of `cells` (satellite-major); each field for
+/// every satellite (cell) in turn, then the next field.
+template <class Io, class Sat, class Cell>
+constexpr void msm_data_fields(Io& io, const MsmFields& f, std::span<Sat> sats, std::span<Cell> cells) {
+  using SatData = std::remove_const_t<Sat>;
+  using CellData = std::remove_const_t<Cell>;
+  io.each(f.rough_range_ms, sats, &SatData::rough_range_ms);          // DF397
+  if (f.extended) io.each(f.info, sats, &SatData::info);              // DF419
+  io.each(f.rough_range_frac, sats, &SatData::rough_range_frac);      // DF398
+  if (f.extended) io.each(f.rough_rate, sats, &SatData::rough_rate);  // DF399
+  io.each(f.pseudorange, cells, &CellData::pseudorange);              // DF400 / DF405
+  io.each(f.phase_range, cells, &CellData::phase_range);              // DF401 / DF406
+  io.each(f.lock_time, cells, &CellData::lock_time);                  // DF402 / DF407
+  io.each(f.half_cycle, cells, &CellData::half_cycle);                // DF420
+  io.each(f.cnr, cells, &CellData::cnr);                              // DF403 / DF408
+  if (f.extended) io.each(f.fine_rate, cells, &CellData::fine_rate);  // DF404
+}
+
+/// make_msm_fields with the bits per satellite and per cell that msm_data_fields sends.
+constexpr MsmFields sized_msm_fields(int type) {
+  MsmFields f = make_msm_fields(type);
+  std::array<MsmSatelliteData, 1> sat{};
+  std::array<MsmSignalData, 1> cell{};
+  FieldCounter one_sat;
+  msm_data_fields(one_sat, f, std::span<MsmSatelliteData>(sat), std::span<MsmSignalData>{});
+  FieldCounter one_cell;
+  msm_data_fields(one_cell, f, std::span<MsmSatelliteData>{}, std::span<MsmSignalData>(cell));
+  f.satellite_bits = one_sat.bits();
+  f.cell_bits = one_cell.bits();
+  return f;
+}
+
+inline constexpr std::array<MsmFields, 4> kMsmFields = {sized_msm_fields(4), sized_msm_fields(5), sized_msm_fields(6),
+                                                        sized_msm_fields(7)};
+/// MSM type 4-7.
+constexpr const MsmFields& msm_fields(int type) {
+  return kMsmFields[static_cast<std::size_t>(type - 4)];
+}
+
+/// Bits of the MSM header (DF002-DF395): 169.
+constexpr std::size_t msm_header_bits() {
+  FieldCounter counter;
+  MsmHeader header;
+  MsmMasks masks;
+  msm_header_fields(counter, header, masks);
+  return counter.bits();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // Station messages.
 
 /// 1005/1006 values that StationPosition holds otherwise.
