@@ -10,9 +10,8 @@
 namespace canyon::io::rtcm3 {
 namespace {
 
-constexpr double kArpLsbM = 1e-4;            // DF025-027
-constexpr double kAntennaHeightLsbM = 1e-4;  // DF028
-constexpr double kBiasLsbM = 0.02;           // DF423-426
+using fields::kAntennaHeightLsbM;
+using fields::kArpLsbM;
 
 std::string short_text(int number, std::size_t bytes) {
   return "RTCM 3 message " + std::to_string(number) + ": " + std::to_string(bytes) + " bytes, too short";
@@ -96,7 +95,7 @@ Status append_glonass_biases(const GlonassBiases& b, std::vector<std::uint8_t>& 
   fields::GlonassBiasWire wire;
   for (std::size_t i = 0; i < 4; ++i) {
     if (!b.bias_m[i]) continue;
-    const double q = std::round(*b.bias_m[i] / kBiasLsbM);
+    const double q = std::round(*b.bias_m[i] / fields::kGlonassBiasLsbM);
     if (!(q > -32768.0 && q < 32768.0)) return Error{"RTCM 3 message 1230: bias out of range (+-655 m)"};
     wire.mask |= 8U >> i;
     wire.bias_m[i] = *b.bias_m[i];

@@ -437,6 +437,10 @@ constexpr std::size_t msm_header_bits() {
 // ---------------------------------------------------------------------------------------------------------------
 // Station messages.
 
+inline constexpr double kArpLsbM = 1e-4;            // DF025-DF027
+inline constexpr double kAntennaHeightLsbM = 1e-4;  // DF028
+inline constexpr double kGlonassBiasLsbM = 0.02;    // DF423-DF426
+
 /// 1005/1006 values that StationPosition holds otherwise.
 struct StationWire {
   int number = 1005;
@@ -446,21 +450,21 @@ struct StationWire {
 /// 1005 stationary antenna reference point, 1006 with the antenna height.
 template <class Io, class Station, class Wire>
 constexpr void station_position_fields(Io& io, Station& st, Wire& w) {
-  io(u(2, 12), w.number);                     // DF002 message number
-  io(u(3, 12), st.station_id);                // DF003 reference station id
-  io(u(21, 6), st.itrf_year);                 // DF021 ITRF realization year
-  io(u(22, 1), st.gps);                       // DF022 GPS indicator
-  io(u(23, 1), st.glonass);                   // DF023 GLONASS indicator
-  io(u(24, 1), st.galileo);                   // DF024 Galileo indicator
-  io(u(141, 1), st.reference_station);        // DF141 reference-station indicator
-  io(s(25, 38, 1e-4, "ARP"), st.arp_E_m[0]);  // DF025 antenna reference point ECEF-X, m
-  io(u(142, 1), st.single_oscillator);        // DF142 single receiver oscillator indicator
-  io(reserved(1));                            // DF001 reserved
-  io(s(26, 38, 1e-4, "ARP"), st.arp_E_m[1]);  // DF026 ECEF-Y, m
-  io(u(364, 2), st.quarter_cycle);            // DF364 quarter cycle indicator
-  io(s(27, 38, 1e-4, "ARP"), st.arp_E_m[2]);  // DF027 ECEF-Z, m
+  io(u(2, 12), w.number);                         // DF002 message number
+  io(u(3, 12), st.station_id);                    // DF003 reference station id
+  io(u(21, 6), st.itrf_year);                     // DF021 ITRF realization year
+  io(u(22, 1), st.gps);                           // DF022 GPS indicator
+  io(u(23, 1), st.glonass);                       // DF023 GLONASS indicator
+  io(u(24, 1), st.galileo);                       // DF024 Galileo indicator
+  io(u(141, 1), st.reference_station);            // DF141 reference-station indicator
+  io(s(25, 38, kArpLsbM, "ARP"), st.arp_E_m[0]);  // DF025 antenna reference point ECEF-X, m
+  io(u(142, 1), st.single_oscillator);            // DF142 single receiver oscillator indicator
+  io(reserved(1));                                // DF001 reserved
+  io(s(26, 38, kArpLsbM, "ARP"), st.arp_E_m[1]);  // DF026 ECEF-Y, m
+  io(u(364, 2), st.quarter_cycle);                // DF364 quarter cycle indicator
+  io(s(27, 38, kArpLsbM, "ARP"), st.arp_E_m[2]);  // DF027 ECEF-Z, m
   if (w.number == 1006) {
-    io(u(28, 16, 1e-4, "antenna height"), w.antenna_height_m);  // DF028 antenna height, m
+    io(u(28, 16, kAntennaHeightLsbM, "antenna height"), w.antenna_height_m);  // DF028 antenna height, m
   }
 }
 
@@ -496,7 +500,7 @@ constexpr void glonass_bias_fields(Io& io, Biases& b, Wire& w) {
   io(u(422, 4), w.mask);       // DF422 GLONASS FDMA signals mask
   for (std::size_t i = 0; i < 4; ++i) {
     // DF423 L1 C/A, DF424 L1 P, DF425 L2 C/A, DF426 L2 P code-phase bias, m
-    if ((w.mask & (8U >> i)) != 0) io(s(423 + static_cast<int>(i), 16, 0.02, "bias"), w.bias_m[i]);
+    if ((w.mask & (8U >> i)) != 0) io(s(423 + static_cast<int>(i), 16, kGlonassBiasLsbM, "bias"), w.bias_m[i]);
   }
 }
 
