@@ -1,5 +1,6 @@
-// RTCM 3 Multiple Signal Messages (RTCM 10403.3 section 3.5.12): header, satellite and signal data of MSM4-MSM7,
-// signal ids, lock time indicators and epoch times; and the RTCM 3 frame (section 4).
+// RTCM 3 Multiple Signal Messages (RTCM 10403.3 section 3.5.12): header, satellite and signal data of MSM4-MSM7
+// (fields in rtcm3_fields.hpp; here the rough and fine ranges, masks and invalid values), signal ids, lock time
+// indicators and epoch times; and the RTCM 3 frame (section 4).
 
 #include <algorithm>
 #include <array>
@@ -9,13 +10,14 @@
 
 #include "canyon/io/bits.hpp"
 #include "canyon/io/rtcm3.hpp"
+#include "canyon/io/rtcm3_fields.hpp"
 
 namespace canyon::io::rtcm3 {
 namespace {
 
 using core::Constellation;
 
-constexpr std::size_t kMsmHeaderBits = 169;  // without the cell mask
+constexpr std::size_t kMsmHeaderBits = fields::msm_header_bits();  // without the cell mask
 constexpr int kMaxCells = 64;
 
 /// RTCM 10403.3 tables 3.5-91 (GPS), 3.5-96 (GLONASS), 3.5-99 (Galileo), 3.5-105 (QZSS), 3.5-108 (BeiDou): RINEX
@@ -58,47 +60,9 @@ int message_base(Constellation system) {
   return 1070;
 }
 
-/// Field layout of an MSM type (4-7).
-struct Layout {
-  bool extended = false;   // extended satellite info and phase range rates (MSM5, MSM7)
-  bool high_res = false;   // MSM6, MSM7
-  unsigned pr_bits = 15;   // DF400 / DF405
-  double pr_lsb_ms = 0.0;  // 2^-24 / 2^-29
-  unsigned ph_bits = 22;   // DF401 / DF406
-  double ph_lsb_ms = 0.0;  // 2^-29 / 2^-31
-  unsigned lock_bits = 4;  // DF402 / DF407
-  unsigned cnr_bits = 6;   // DF403 / DF408
-  double cnr_lsb = 1.0;    // 1 / 2^-4 dB-Hz
-  [[nodiscard]] unsigned sat_bits() const { return extended ? 36 : 18; }
-  [[nodiscard]] unsigned cell_bits() const {
-    return pr_bits + ph_bits + lock_bits + 1 + cnr_bits + (extended ? 15 : 0);
-  }
-};
-
-Layout layout(int type) {
-  Layout l;
-  l.extended = type == 5 || type == 7;
-  l.high_res = type >= 6;
-  if (l.high_res) {
-    l.pr_bits = 20;
-    l.pr_lsb_ms = 1.0 / 536870912.0;  // 2^-29
-    l.ph_bits = 24;
-    l.ph_lsb_ms = 1.0 / 2147483648.0;  // 2^-31
-    l.lock_bits = 10;
-    l.cnr_bits = 10;
-    l.cnr_lsb = 1.0 / 16.0;
-  } else {
-    l.pr_lsb_ms = 1.0 / 16777216.0;   // 2^-24
-    l.ph_lsb_ms = 1.0 / 536870912.0;  // 2^-29
-  }
-  return l;
-}
-
-constexpr double kRoughLsbMs = 1.0 / 1024.0;       // DF398
 constexpr int kInvalidRoughInt = 255;              // DF397
 constexpr std::int64_t kInvalidRate = -8192;       // DF399
 constexpr std::int64_t kInvalidFineRate = -16384;  // DF404
-constexpr double kFineRateLsbMps = 1e-4;
 
 std::string message_text(int number) {
   return "RTCM 3 message " + std::to_string(number);
@@ -271,29 +235,32 @@ std::uint32_t msm_epoch_field(Constellation system, const core::GpsTime& time, c
   return 0;
 }
 
-Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::uint8_t>& out) {
-  const MsmHeader& h = message.header;
-  const int number = msm_message_number(h.system, h.type);
-  if (h.type < 4 || h.type > 7) return Error{message_text(number) + ": only MSM4-MSM7 can be encoded"};
-  const Layout l = layout(h.type);
-  MsmEncodeReport report;
+namespace {
 
-  // Rough range per satellite: the first pseudorange, else the first phase range, rounded to 2^-10 ms.
-  struct SatPlan {
-    const MsmSatellite* sat = nullptr;
-    double rough_ms = 0.0;
-    double rough_rate_mps = 0.0;
-    bool rate_valid = false;
-  };
-  std::vector<SatPlan> sats;
-  sats.reserve(message.satellites.size());
-  std::uint64_t sat_mask = 0;
-  std::uint32_t sig_mask = 0;
+/// A satellite to send: its rough range (2^-10 ms) and rough phase range rate (whole m/s).
+struct SatPlan {
+  const MsmSatellite* sat = nullptr;
+  double rough_ms = 0.0;
+  double rough_rate_mps = 0.0;
+  bool rate_valid = false;
+};
+/// A cell to send, in satellite-major order.
+struct CellPlan {
+  const MsmCell* cell = nullptr;
+  const SatPlan* sat = nullptr;
+};
+
+/// The satellites that have a rough range (the first pseudorange, else the first phase range), in satellite id order,
+/// and the satellite and signal masks; the others are counted as dropped.
+Status plan_satellites(const MsmMessage& message, const fields::MsmFields& f, std::vector<SatPlan>& sats,
+                       fields::MsmMasks& masks, MsmEncodeReport& report) {
+  const int number = masks.number;
+  const double rough_lsb_ms = f.rough_range_frac.lsb;
   for (const MsmSatellite& s : message.satellites) {
     if (s.satellite_id < 1 || s.satellite_id > 64) {
       return Error{message_text(number) + ": satellite id " + std::to_string(s.satellite_id) + " outside 1-64"};
     }
-    if ((sat_mask & (std::uint64_t{1} << (64 - s.satellite_id))) != 0) {
+    if ((masks.satellites & (std::uint64_t{1} << (64 - s.satellite_id))) != 0) {
       return Error{message_text(number) + ": satellite id " + std::to_string(s.satellite_id) + " given twice"};
     }
     SatPlan plan{&s};
@@ -312,7 +279,7 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
         }
       }
     }
-    const double rough_ms = std::floor(rough_m / kRangeMsM / kRoughLsbMs + 0.5) * kRoughLsbMs;
+    const double rough_ms = std::floor(rough_m / kRangeMsM / rough_lsb_ms + 0.5) * rough_lsb_ms;
     if (!(rough_ms > 0.0 && rough_ms < kInvalidRoughInt)) {
       ++report.dropped_satellites;
       continue;
@@ -329,34 +296,33 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
       if (c.signal_id < 1 || c.signal_id > 32) {
         return Error{message_text(number) + ": signal id " + std::to_string(c.signal_id) + " outside 1-32"};
       }
-      sig_mask |= 1U << (32 - c.signal_id);
+      masks.signals |= 1U << (32 - c.signal_id);
     }
-    sat_mask |= std::uint64_t{1} << (64 - s.satellite_id);
+    masks.satellites |= std::uint64_t{1} << (64 - s.satellite_id);
     sats.push_back(plan);
   }
   std::sort(sats.begin(), sats.end(),
             [](const SatPlan& a, const SatPlan& b) { return a.sat->satellite_id < b.sat->satellite_id; });
+  return Ok{};
+}
+
+/// The signal ids of a signal mask, in order.
+std::array<int, 32> signal_ids_of(std::uint32_t signal_mask) {
+  std::array<int, 32> ids{};
+  int k = 0;
+  for (int id = 1; id <= 32; ++id) {
+    if ((signal_mask & (1U << (32 - id))) != 0) ids[static_cast<std::size_t>(k++)] = id;
+  }
+  return ids;
+}
+
+/// The cells of the planned satellites, satellite-major, and the cell mask; the number of cells.
+Result<int> plan_cells(const std::vector<SatPlan>& sats, fields::MsmMasks& masks,
+                       std::array<CellPlan, kMaxCells>& cells) {
   const int nsat = static_cast<int>(sats.size());
-  const int nsig = std::popcount(sig_mask);
-  if (nsat * nsig > kMaxCells) {
-    return Error{message_text(number) + ": " + std::to_string(nsat) + " satellites x " + std::to_string(nsig) +
-                 " signals exceed the 64-cell mask; split the satellites over several messages"};
-  }
-  std::array<int, 32> signal_ids{};
-  {
-    int k = 0;
-    for (int id = 1; id <= 32; ++id) {
-      if ((sig_mask & (1U << (32 - id))) != 0) signal_ids[static_cast<std::size_t>(k++)] = id;
-    }
-  }
-  // Cells in satellite-major order, and the cell mask.
-  struct CellPlan {
-    const MsmCell* cell;
-    const SatPlan* sat;
-  };
-  std::array<CellPlan, kMaxCells> cells{};
+  const int nsig = std::popcount(masks.signals);
+  const std::array<int, 32> signal_ids = signal_ids_of(masks.signals);
   int ncell = 0;
-  std::uint64_t cell_mask = 0;
   int cell_bit = 0;
   for (const SatPlan& sp : sats) {
     for (int k = 0; k < nsig; ++k, ++cell_bit) {
@@ -364,103 +330,167 @@ Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::u
       for (const MsmCell& c : sp.sat->cells) {
         if (c.signal_id == signal_ids[static_cast<std::size_t>(k)]) {
           if (found != nullptr) {
-            return Error{message_text(number) + ": signal id " + std::to_string(c.signal_id) +
+            return Error{message_text(masks.number) + ": signal id " + std::to_string(c.signal_id) +
                          " given twice for satellite " + std::to_string(sp.sat->satellite_id)};
           }
           found = &c;
         }
       }
       if (found != nullptr) {
-        cell_mask |= std::uint64_t{1} << (nsat * nsig - 1 - cell_bit);
+        masks.cells |= std::uint64_t{1} << (nsat * nsig - 1 - cell_bit);
         cells[static_cast<std::size_t>(ncell++)] = CellPlan{found, &sp};
       }
     }
   }
-  const std::size_t total_bits = kMsmHeaderBits + static_cast<std::size_t>(nsat * nsig) +
-                                 static_cast<std::size_t>(nsat) * l.sat_bits() +
-                                 static_cast<std::size_t>(ncell) * l.cell_bits();
-  if ((total_bits + 7) / 8 > kMaxPayloadBytes) {
-    return Error{message_text(number) + ": " + std::to_string((total_bits + 7) / 8) + " bytes exceed 1023"};
+  return ncell;
+}
+
+/// The satellite data of the planned satellites, as sent.
+void pack_satellites(const fields::MsmFields& f, const std::vector<SatPlan>& sats,
+                     std::span<fields::MsmSatelliteData> out) {
+  for (std::size_t i = 0; i < sats.size(); ++i) {
+    const SatPlan& sp = sats[i];
+    const double whole_ms = std::floor(sp.rough_ms);
+    out[i].rough_range_ms = static_cast<std::uint32_t>(whole_ms);
+    out[i].info = static_cast<std::uint32_t>(sp.sat->extended_info & 0xF);
+    out[i].rough_range_frac =
+        static_cast<std::uint32_t>(std::lround((sp.rough_ms - whole_ms) / f.rough_range_frac.lsb));
+    out[i].rough_rate =
+        static_cast<std::int32_t>(sp.rate_valid ? static_cast<std::int64_t>(sp.rough_rate_mps) : kInvalidRate);
   }
+}
+
+/// The signal data of the planned cells, as sent: values that do not fit their field are sent invalid and counted.
+void pack_cells(const fields::MsmFields& f, std::span<const CellPlan> cells, std::span<fields::MsmSignalData> out,
+                MsmEncodeReport& report) {
+  auto fine = [&](double value_m, double rough_ms, const fields::Field& field) -> std::int32_t {
+    if (!core::has_value(value_m)) return static_cast<std::int32_t>(invalid_marker(field.bits));
+    const auto q = fit_signed(value_m / kRangeMsM - rough_ms, field.lsb, field.bits);
+    if (!q) {
+      ++report.invalid_values;
+      return static_cast<std::int32_t>(invalid_marker(field.bits));
+    }
+    return static_cast<std::int32_t>(*q);
+  };
+  const double max_cnr = static_cast<double>((1U << f.cnr.bits) - 1);
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const MsmCell& cell = *cells[i].cell;
+    const SatPlan& sat = *cells[i].sat;
+    fields::MsmSignalData& d = out[i];
+    d.pseudorange = fine(cell.pseudorange_m, sat.rough_ms, f.pseudorange);
+    d.phase_range = fine(cell.phase_range_m, sat.rough_ms, f.phase_range);
+    d.lock_time = static_cast<std::uint32_t>(msm_lock_indicator(cell.lock_time_ms, f.high_resolution));
+    d.half_cycle = cell.half_cycle;
+    const double cnr = cell.cnr_dbhz;
+    d.cnr = static_cast<std::uint32_t>(
+        core::has_value(cnr) ? std::clamp(std::floor(cnr / f.cnr.lsb + 0.5), 1.0, max_cnr) : 0.0);
+    d.fine_rate = static_cast<std::int32_t>(kInvalidFineRate);
+    if (!f.extended) continue;
+    if (core::has_value(cell.phase_range_rate_mps) && sat.rate_valid) {
+      const auto q = fit_signed(cell.phase_range_rate_mps - sat.rough_rate_mps, f.fine_rate.lsb, f.fine_rate.bits);
+      if (q) {
+        d.fine_rate = static_cast<std::int32_t>(*q);
+      } else {
+        ++report.invalid_values;
+      }
+    } else if (core::has_value(cell.phase_range_rate_mps)) {
+      ++report.invalid_values;
+    }
+  }
+}
+
+/// The satellites and cells of a decoded MSM from its masks and data as sent.
+void unpack_msm(const fields::MsmFields& f, const fields::MsmMasks& masks,
+                std::span<const fields::MsmSatelliteData> sat_data, std::span<const fields::MsmSignalData> cell_data,
+                std::vector<MsmSatellite>& satellites) {
+  const int nsat = static_cast<int>(sat_data.size());
+  const int nsig = std::popcount(masks.signals);
+  const std::array<int, 32> signal_ids = signal_ids_of(masks.signals);
+  const std::int64_t pr_invalid = invalid_marker(f.pseudorange.bits);
+  const std::int64_t ph_invalid = invalid_marker(f.phase_range.bits);
+  satellites.resize(static_cast<std::size_t>(nsat));
+  std::size_t k = 0;  // cell
+  int id = 0;         // satellite id
+  for (int i = 0; i < nsat; ++i) {
+    while ((masks.satellites & (std::uint64_t{1} << (63 - id))) == 0) ++id;
+    const fields::MsmSatelliteData& sd = sat_data[static_cast<std::size_t>(i)];
+    MsmSatellite& s = satellites[static_cast<std::size_t>(i)];
+    s.satellite_id = ++id;
+    s.extended_info = f.extended ? static_cast<int>(sd.info) : 15;
+    s.cells.clear();
+    double rough_ms = sd.rough_range_ms == kInvalidRoughInt ? core::kNoValue : static_cast<int>(sd.rough_range_ms);
+    rough_ms += static_cast<double>(sd.rough_range_frac) * f.rough_range_frac.lsb;
+    const double rough_rate =
+        f.extended && sd.rough_rate != kInvalidRate ? static_cast<double>(sd.rough_rate) : core::kNoValue;
+    for (int g = 0; g < nsig; ++g) {
+      if ((masks.cells & (std::uint64_t{1} << (nsat * nsig - 1 - (i * nsig + g)))) == 0) continue;
+      const fields::MsmSignalData& d = cell_data[k++];
+      MsmCell cell;
+      cell.signal_id = signal_ids[static_cast<std::size_t>(g)];
+      cell.pseudorange_m = d.pseudorange == pr_invalid
+                               ? core::kNoValue
+                               : (rough_ms + static_cast<double>(d.pseudorange) * f.pseudorange.lsb) * kRangeMsM;
+      cell.phase_range_m = d.phase_range == ph_invalid
+                               ? core::kNoValue
+                               : (rough_ms + static_cast<double>(d.phase_range) * f.phase_range.lsb) * kRangeMsM;
+      cell.lock_indicator = static_cast<int>(d.lock_time);
+      cell.lock_time_ms = msm_lock_time_ms(cell.lock_indicator, f.high_resolution);
+      cell.half_cycle = d.half_cycle;
+      cell.cnr_dbhz = d.cnr == 0 ? core::kNoValue : static_cast<double>(d.cnr) * f.cnr.lsb;
+      if (f.extended) {
+        cell.phase_range_rate_mps = d.fine_rate == kInvalidFineRate
+                                        ? core::kNoValue
+                                        : rough_rate + static_cast<double>(d.fine_rate) * f.fine_rate.lsb;
+      }
+      s.cells.push_back(cell);
+    }
+  }
+}
+
+}  // namespace
+
+Result<MsmEncodeReport> append_msm(const MsmMessage& message, std::vector<std::uint8_t>& out) {
+  const MsmHeader& h = message.header;
+  fields::MsmMasks masks;
+  masks.number = msm_message_number(h.system, h.type);
+  if (h.type < 4 || h.type > 7) return Error{message_text(masks.number) + ": only MSM4-MSM7 can be encoded"};
+  const fields::MsmFields& f = fields::msm_fields(h.type);
+  MsmEncodeReport report;
+  std::vector<SatPlan> sats;
+  sats.reserve(message.satellites.size());
+  if (Status s = plan_satellites(message, f, sats, masks, report); !s.ok()) return s.error();
+  const int nsat = static_cast<int>(sats.size());
+  const int nsig = std::popcount(masks.signals);
+  if (nsat * nsig > kMaxCells) {
+    return Error{message_text(masks.number) + ": " + std::to_string(nsat) + " satellites x " + std::to_string(nsig) +
+                 " signals exceed the 64-cell mask; split the satellites over several messages"};
+  }
+  std::array<CellPlan, kMaxCells> cells{};
+  const Result<int> ncell = plan_cells(sats, masks, cells);
+  if (!ncell.ok()) return ncell.error();
+  const std::size_t total_bits = kMsmHeaderBits + static_cast<std::size_t>(nsat * nsig) +
+                                 static_cast<std::size_t>(nsat) * f.satellite_bits +
+                                 static_cast<std::size_t>(*ncell) * f.cell_bits;
+  if ((total_bits + 7) / 8 > kMaxPayloadBytes) {
+    return Error{message_text(masks.number) + ": " + std::to_string((total_bits + 7) / 8) + " bytes exceed 1023"};
+  }
+  std::array<fields::MsmSatelliteData, kMaxCells> sat_data;
+  std::array<fields::MsmSignalData, kMaxCells> cell_data;
+  const std::span<fields::MsmSatelliteData> sat_span(sat_data.data(), sats.size());
+  const std::span<fields::MsmSignalData> cell_span(cell_data.data(), static_cast<std::size_t>(*ncell));
+  pack_satellites(f, sats, sat_span);
+  pack_cells(f, std::span<const CellPlan>(cells.data(), cell_span.size()), cell_span, report);
 
   const std::size_t start = out.size();
   out.resize(start + (total_bits + 7) / 8);
-  FixedBitWriter w(out.data() + start);
-  w.u(static_cast<std::uint64_t>(number), 12);
-  w.u(static_cast<std::uint64_t>(h.station_id & 0xFFF), 12);
-  w.u(h.epoch_time & 0x3FFFFFFF, 30);
-  w.u(h.multiple_message ? 1 : 0, 1);
-  w.u(static_cast<std::uint64_t>(h.iods & 7), 3);
-  w.u(0, 7);
-  w.u(static_cast<std::uint64_t>(h.clock_steering & 3), 2);
-  w.u(static_cast<std::uint64_t>(h.external_clock & 3), 2);
-  w.u(h.divergence_free_smoothing ? 1 : 0, 1);
-  w.u(static_cast<std::uint64_t>(h.smoothing_interval & 7), 3);
-  w.u(sat_mask, 64);
-  w.u(sig_mask, 32);
-  w.u(cell_mask, static_cast<unsigned>(nsat * nsig));
-
-  // Satellite data, field by field.
-  for (const SatPlan& sp : sats) w.u(static_cast<std::uint64_t>(std::floor(sp.rough_ms)), 8);
-  if (l.extended) {
-    for (const SatPlan& sp : sats) w.u(static_cast<std::uint64_t>(sp.sat->extended_info & 0xF), 4);
-  }
-  for (const SatPlan& sp : sats) {
-    w.u(static_cast<std::uint64_t>(std::lround((sp.rough_ms - std::floor(sp.rough_ms)) / kRoughLsbMs)), 10);
-  }
-  if (l.extended) {
-    for (const SatPlan& sp : sats) w.s(sp.rate_valid ? static_cast<std::int64_t>(sp.rough_rate_mps) : kInvalidRate, 14);
-  }
-
-  // Signal data, field by field.
-  auto fine = [&](double value_m, double rough_ms, double lsb_ms, unsigned bits) -> std::int64_t {
-    if (!core::has_value(value_m)) return invalid_marker(bits);
-    const auto q = fit_signed(value_m / kRangeMsM - rough_ms, lsb_ms, bits);
-    if (!q) {
-      ++report.invalid_values;
-      return invalid_marker(bits);
-    }
-    return *q;
-  };
-  for (int i = 0; i < ncell; ++i) {
-    const CellPlan& c = cells[static_cast<std::size_t>(i)];
-    w.s(fine(c.cell->pseudorange_m, c.sat->rough_ms, l.pr_lsb_ms, l.pr_bits), l.pr_bits);
-  }
-  for (int i = 0; i < ncell; ++i) {
-    const CellPlan& c = cells[static_cast<std::size_t>(i)];
-    w.s(fine(c.cell->phase_range_m, c.sat->rough_ms, l.ph_lsb_ms, l.ph_bits), l.ph_bits);
-  }
-  for (int i = 0; i < ncell; ++i) {
-    w.u(static_cast<std::uint64_t>(
-            msm_lock_indicator(cells[static_cast<std::size_t>(i)].cell->lock_time_ms, l.high_res)),
-        l.lock_bits);
-  }
-  for (int i = 0; i < ncell; ++i) w.u(cells[static_cast<std::size_t>(i)].cell->half_cycle ? 1 : 0, 1);
-  const double max_cnr = static_cast<double>((1U << l.cnr_bits) - 1);
-  for (int i = 0; i < ncell; ++i) {
-    const double cnr = cells[static_cast<std::size_t>(i)].cell->cnr_dbhz;
-    const double q = core::has_value(cnr) ? std::clamp(std::floor(cnr / l.cnr_lsb + 0.5), 1.0, max_cnr) : 0.0;
-    w.u(static_cast<std::uint64_t>(q), l.cnr_bits);
-  }
-  if (l.extended) {
-    for (int i = 0; i < ncell; ++i) {
-      const CellPlan& c = cells[static_cast<std::size_t>(i)];
-      std::int64_t q = kInvalidFineRate;
-      if (core::has_value(c.cell->phase_range_rate_mps) && c.sat->rate_valid) {
-        const auto f = fit_signed(c.cell->phase_range_rate_mps - c.sat->rough_rate_mps, kFineRateLsbMps, 15);
-        if (f) {
-          q = *f;
-        } else {
-          ++report.invalid_values;
-        }
-      } else if (core::has_value(c.cell->phase_range_rate_mps)) {
-        ++report.invalid_values;
-      }
-      w.s(q, 15);
-    }
-  }
-  w.flush();
-  report.cells = ncell;
+  FixedBitWriter bits(out.data() + start);
+  fields::FieldWriter w(bits, masks.number);
+  fields::msm_header_fields(w, h, masks);
+  fields::msm_cell_mask_field(w, masks);
+  fields::msm_data_fields(w, f, std::span<const fields::MsmSatelliteData>(sat_span),
+                          std::span<const fields::MsmSignalData>(cell_span));
+  bits.flush();
+  report.cells = *ncell;
   return report;
 }
 
@@ -478,7 +508,7 @@ Status decode_msm(std::span<const std::uint8_t> payload, MsmMessage& m) {
     return Error{message_text(number) + ": MSM" + std::to_string(kind->type) +
                  " carries no complete observables; only MSM4-MSM7 are decoded"};
   }
-  BitReader r(payload);
+  fields::FieldReader r(payload);
   if (r.bits_left() < kMsmHeaderBits) {
     return Error{message_text(number) + ": " + std::to_string(payload.size()) + " bytes, shorter than an MSM header"};
   }
@@ -486,20 +516,10 @@ Status decode_msm(std::span<const std::uint8_t> payload, MsmMessage& m) {
   h = MsmHeader{};
   h.system = kind->system;
   h.type = kind->type;
-  r.skip(12);
-  h.station_id = static_cast<int>(r.u(12));
-  h.epoch_time = r.u32(30);
-  h.multiple_message = r.u(1) != 0;
-  h.iods = static_cast<int>(r.u(3));
-  r.skip(7);
-  h.clock_steering = static_cast<int>(r.u(2));
-  h.external_clock = static_cast<int>(r.u(2));
-  h.divergence_free_smoothing = r.u(1) != 0;
-  h.smoothing_interval = static_cast<int>(r.u(3));
-  const std::uint64_t sat_mask = r.u(64);
-  const auto sig_mask = static_cast<std::uint32_t>(r.u(32));
-  const int nsat = std::popcount(sat_mask);
-  const int nsig = std::popcount(sig_mask);
+  fields::MsmMasks masks;
+  fields::msm_header_fields(r, h, masks);
+  const int nsat = std::popcount(masks.satellites);
+  const int nsig = std::popcount(masks.signals);
   if (nsat * nsig > kMaxCells) {
     return Error{message_text(number) + ": masks announce " + std::to_string(nsat) + " satellites x " +
                  std::to_string(nsig) + " signals, more than 64 cells"};
@@ -508,106 +528,22 @@ Status decode_msm(std::span<const std::uint8_t> payload, MsmMessage& m) {
   if (r.bits_left() < static_cast<std::size_t>(mask_bits)) {
     return Error{message_text(number) + ": payload ends inside the cell mask"};
   }
-  const std::uint64_t cell_mask = r.u(static_cast<unsigned>(mask_bits));
-  const int ncell = std::popcount(cell_mask);
-  const Layout l = layout(h.type);
+  fields::msm_cell_mask_field(r, masks);
+  const int ncell = std::popcount(masks.cells);
+  const fields::MsmFields& f = fields::msm_fields(h.type);
   const std::size_t needed =
-      static_cast<std::size_t>(nsat) * l.sat_bits() + static_cast<std::size_t>(ncell) * l.cell_bits();
+      static_cast<std::size_t>(nsat) * f.satellite_bits + static_cast<std::size_t>(ncell) * f.cell_bits;
   if (r.bits_left() < needed) {
     return Error{message_text(number) + ": " + std::to_string(payload.size()) + " bytes, too short for " +
                  std::to_string(nsat) + " satellites and " + std::to_string(ncell) + " cells (needs " +
                  std::to_string((r.position() + needed + 7) / 8) + ")"};
   }
-  std::array<int, 32> signal_ids{};
-  {
-    int k = 0;
-    for (int id = 1; id <= 32; ++id) {
-      if ((sig_mask & (1U << (32 - id))) != 0) signal_ids[static_cast<std::size_t>(k++)] = id;
-    }
-  }
-  m.satellites.resize(static_cast<std::size_t>(nsat));
-  for (MsmSatellite& s : m.satellites) {
-    s.extended_info = 15;
-    s.cells.clear();
-  }
-  std::array<double, 64> rough_ms{};
-  std::array<double, 64> rough_rate{};
-  {
-    int k = 0;
-    for (int id = 1; id <= 64; ++id) {
-      if ((sat_mask & (std::uint64_t{1} << (64 - id))) != 0)
-        m.satellites[static_cast<std::size_t>(k++)].satellite_id = id;
-    }
-  }
-  for (int i = 0; i < nsat; ++i) {
-    const auto v = static_cast<int>(r.u(8));
-    rough_ms[static_cast<std::size_t>(i)] = v == kInvalidRoughInt ? core::kNoValue : v;
-  }
-  if (l.extended) {
-    for (int i = 0; i < nsat; ++i) m.satellites[static_cast<std::size_t>(i)].extended_info = static_cast<int>(r.u(4));
-  }
-  for (int i = 0; i < nsat; ++i) rough_ms[static_cast<std::size_t>(i)] += static_cast<double>(r.u(10)) * kRoughLsbMs;
-  if (l.extended) {
-    for (int i = 0; i < nsat; ++i) {
-      const std::int64_t v = r.s(14);
-      rough_rate[static_cast<std::size_t>(i)] = v == kInvalidRate ? core::kNoValue : static_cast<double>(v);
-    }
-  }
-  // Cells, satellite-major.
-  std::array<int, 64> cell_sat{};
-  {
-    int k = 0;
-    for (int s = 0; s < nsat; ++s) {
-      for (int g = 0; g < nsig; ++g) {
-        if ((cell_mask & (std::uint64_t{1} << (nsat * nsig - 1 - (s * nsig + g)))) == 0) continue;
-        cell_sat[static_cast<std::size_t>(k)] = s;
-        MsmCell cell;
-        cell.signal_id = signal_ids[static_cast<std::size_t>(g)];
-        m.satellites[static_cast<std::size_t>(s)].cells.push_back(cell);
-        ++k;
-      }
-    }
-  }
-  // Cell pointers in transmission order.
-  std::array<MsmCell*, 64> cell_ptr{};
-  {
-    int k = 0;
-    for (MsmSatellite& s : m.satellites) {
-      for (MsmCell& c : s.cells) cell_ptr[static_cast<std::size_t>(k++)] = &c;
-    }
-  }
-  const std::int64_t pr_invalid = invalid_marker(l.pr_bits);
-  const std::int64_t ph_invalid = invalid_marker(l.ph_bits);
-  for (int i = 0; i < ncell; ++i) {
-    const std::int64_t v = r.s(l.pr_bits);
-    const double rough = rough_ms[static_cast<std::size_t>(cell_sat[static_cast<std::size_t>(i)])];
-    cell_ptr[static_cast<std::size_t>(i)]->pseudorange_m =
-        v == pr_invalid ? core::kNoValue : (rough + static_cast<double>(v) * l.pr_lsb_ms) * kRangeMsM;
-  }
-  for (int i = 0; i < ncell; ++i) {
-    const std::int64_t v = r.s(l.ph_bits);
-    const double rough = rough_ms[static_cast<std::size_t>(cell_sat[static_cast<std::size_t>(i)])];
-    cell_ptr[static_cast<std::size_t>(i)]->phase_range_m =
-        v == ph_invalid ? core::kNoValue : (rough + static_cast<double>(v) * l.ph_lsb_ms) * kRangeMsM;
-  }
-  for (int i = 0; i < ncell; ++i) {
-    const auto indicator = static_cast<int>(r.u(l.lock_bits));
-    cell_ptr[static_cast<std::size_t>(i)]->lock_indicator = indicator;
-    cell_ptr[static_cast<std::size_t>(i)]->lock_time_ms = msm_lock_time_ms(indicator, l.high_res);
-  }
-  for (int i = 0; i < ncell; ++i) cell_ptr[static_cast<std::size_t>(i)]->half_cycle = r.u(1) != 0;
-  for (int i = 0; i < ncell; ++i) {
-    const std::uint64_t v = r.u(l.cnr_bits);
-    cell_ptr[static_cast<std::size_t>(i)]->cnr_dbhz = v == 0 ? core::kNoValue : static_cast<double>(v) * l.cnr_lsb;
-  }
-  if (l.extended) {
-    for (int i = 0; i < ncell; ++i) {
-      const std::int64_t v = r.s(15);
-      const double rough = rough_rate[static_cast<std::size_t>(cell_sat[static_cast<std::size_t>(i)])];
-      cell_ptr[static_cast<std::size_t>(i)]->phase_range_rate_mps =
-          v == kInvalidFineRate ? core::kNoValue : rough + static_cast<double>(v) * kFineRateLsbMps;
-    }
-  }
+  std::array<fields::MsmSatelliteData, kMaxCells> sat_data;
+  std::array<fields::MsmSignalData, kMaxCells> cell_data;
+  const std::span<fields::MsmSatelliteData> sats(sat_data.data(), static_cast<std::size_t>(nsat));
+  const std::span<fields::MsmSignalData> cells(cell_data.data(), static_cast<std::size_t>(ncell));
+  fields::msm_data_fields(r, f, sats, cells);
+  unpack_msm(f, masks, sats, cells, m.satellites);
   return Ok{};
 }
 

@@ -5,8 +5,12 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <random>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -14,6 +18,7 @@
 #include "canyon/core/constants.hpp"
 #include "canyon/io/bits.hpp"
 #include "canyon/io/rtcm3_codec.hpp"
+#include "canyon/io/rtcm3_fields.hpp"
 #include "canyon/io/stream_framer.hpp"
 
 namespace canyon::io {
@@ -500,6 +505,264 @@ TEST(Rtcm3Ephemeris, ErrorsNameTheProblem) {
   auto d = rtcm3::decode_kepler_ephemeris({payload.data(), 40}, GpsTime{2176, 288000.0});
   ASSERT_FALSE(d.ok());
   EXPECT_NE(d.error().message.find("40 bytes, needs 61"), std::string::npos) << d.error().message;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Field layouts (rtcm3_fields.hpp).
+
+TEST(Rtcm3Fields, LayoutsAddUpToTheMessageLengths) {
+  namespace f = rtcm3::fields;
+  auto bits = [](auto&& layout) {
+    f::FieldCounter counter;
+    layout(counter);
+    return counter.bits();
+  };
+  rtcm3::StationPosition station;
+  f::StationWire station_wire;
+  EXPECT_EQ(bits([&](auto& io) { f::station_position_fields(io, station, station_wire); }), 152U);
+  station_wire.number = 1006;
+  EXPECT_EQ(bits([&](auto& io) { f::station_position_fields(io, station, station_wire); }), 168U);
+  rtcm3::GlonassBiases biases;
+  f::GlonassBiasWire bias_wire;
+  EXPECT_EQ(bits([&](auto& io) { f::glonass_bias_fields(io, biases, bias_wire); }), 32U);
+  bias_wire.mask = 0xF;
+  EXPECT_EQ(bits([&](auto& io) { f::glonass_bias_fields(io, biases, bias_wire); }), 32U + 4 * 16);
+  rtcm3::AntennaInfo antenna;
+  antenna.antenna_descriptor = "ABC";
+  for (const auto& [number, expected] :
+       {std::pair{1007, 12 + 12 + 8 + 24 + 8}, std::pair{1008, 64 + 8}, std::pair{1033, 72 + 3 * 8}}) {
+    int n = number;
+    EXPECT_EQ(bits([&](auto& io) { f::antenna_info_fields(io, antenna, n); }), static_cast<std::size_t>(expected));
+  }
+  core::KeplerEphemeris kepler;
+  f::KeplerWire kepler_wire;
+  for (const auto& [number, expected] :
+       {std::pair{1019, 488}, std::pair{1044, 485}, std::pair{1042, 511}, std::pair{1045, 496}, std::pair{1046, 504}}) {
+    kepler_wire.number = number;
+    EXPECT_EQ(bits([&](auto& io) { EXPECT_TRUE(f::kepler_ephemeris_fields(io, kepler, kepler_wire)); }),
+              static_cast<std::size_t>(expected))
+        << number;
+  }
+  kepler_wire.number = 1020;
+  EXPECT_FALSE(f::kepler_ephemeris_fields(*std::make_unique<f::FieldCounter>(), kepler, kepler_wire));
+  core::GlonassEphemeris glonass;
+  f::GlonassWire glonass_wire;
+  EXPECT_EQ(bits([&](auto& io) { f::glonass_ephemeris_fields(io, glonass, glonass_wire); }), 360U);
+  // MSM: header, and per satellite / per cell of MSM4-7 (RTCM 10403.3 tables 3.5-78 ff.).
+  EXPECT_EQ(f::msm_header_bits(), 169U);
+  const std::size_t satellite_bits[] = {18, 36, 18, 36};
+  const std::size_t cell_bits[] = {48, 63, 65, 80};
+  for (int type = 4; type <= 7; ++type) {
+    EXPECT_EQ(f::msm_fields(type).satellite_bits, satellite_bits[type - 4]) << type;
+    EXPECT_EQ(f::msm_fields(type).cell_bits, cell_bits[type - 4]) << type;
+  }
+  rtcm3::LegacyObsMessage legacy;
+  f::LegacyWire legacy_wire;
+  f::LegacySatelliteWire legacy_sat;
+  for (const auto& [number, header, satellite] : {std::tuple{1004, 64, 125}, std::tuple{1012, 61, 130}}) {
+    legacy_wire.number = number;
+    const bool glonass = number == 1012;
+    EXPECT_EQ(bits([&](auto& io) { f::legacy_header_fields(io, legacy, legacy_wire); }),
+              static_cast<std::size_t>(header));
+    EXPECT_EQ(bits([&](auto& io) { f::legacy_satellite_fields(io, glonass, legacy_sat); }),
+              static_cast<std::size_t>(satellite));
+  }
+}
+
+TEST(Rtcm3Fields, OneFieldListEncodesDecodesAndChecks) {
+  namespace f = rtcm3::fields;
+  struct Values {
+    double angle_rad = 0.0;
+    double height_m = 0.0;
+    double position_m = 0.0;
+    int masked = 0;
+    int checked = 0;
+    bool flag = false;
+    std::string text;
+  };
+  auto layout = [](auto& io, auto& v) {
+    io(f::s(1, 14, f::p2(-43), "angle", f::Unit::Semicircle), v.angle_rad);
+    io(f::u(2, 16, 1e-4, "height"), v.height_m);
+    io(f::sm(3, 27, f::p2(-11), "position", f::Unit::Kilometre), v.position_m);
+    io(f::u(4, 4), v.masked);
+    io(f::reserved(3));
+    io(f::u(5, 6, "checked"), v.checked);
+    io(f::u(6, 1), v.flag);
+    io(f::text(7, "text"), v.text);
+  };
+  Values in;
+  in.angle_rad = 2.1e-10;
+  in.height_m = 1.23456;
+  in.position_m = -19876543.2;
+  in.masked = 0x1F;  // 5 bits into 4: its low bits
+  in.checked = 63;
+  in.flag = true;
+  in.text = "canyon";
+  std::vector<std::uint8_t> payload;
+  {
+    BitWriter bits(payload);
+    f::FieldWriter w(bits, 999);
+    layout(w, in);
+    ASSERT_TRUE(w.status().ok());
+  }
+  f::FieldCounter counter;
+  layout(counter, in);
+  EXPECT_EQ(payload.size(), (counter.bits() + 7) / 8);
+  Values out;
+  f::FieldReader<true> r(payload);
+  layout(r, out);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(out.angle_rad,
+            std::round(in.angle_rad / rtcm3::kGpsPi / std::ldexp(1.0, -43)) * std::ldexp(1.0, -43) * rtcm3::kGpsPi);
+  EXPECT_EQ(out.height_m, 12346 * 1e-4);
+  EXPECT_EQ(out.position_m, -std::round(19876543.2 * 1e-3 / std::ldexp(1.0, -11)) * std::ldexp(1.0, -11) * 1e3);
+  EXPECT_EQ(out.masked, 0xF);
+  EXPECT_EQ(out.checked, 63);
+  EXPECT_TRUE(out.flag);
+  EXPECT_EQ(out.text, "canyon");
+  // A checked reader stops at the end of the payload; a named field out of range is an Error naming it.
+  f::FieldReader<true> short_reader({payload.data(), payload.size() - 3});
+  layout(short_reader, out);
+  EXPECT_FALSE(short_reader.ok());
+  in.checked = 64;
+  payload.clear();
+  BitWriter bits(payload);
+  f::FieldWriter w(bits, 999);
+  layout(w, in);
+  ASSERT_FALSE(w.status().ok());
+  EXPECT_EQ(w.status().error().message, "RTCM 3 message 999: checked out of its field's range");
+}
+
+/// One payload of every message type canyon encodes, from fixed values (MSM cells from a seeded generator).
+std::vector<std::pair<std::string, std::vector<std::uint8_t>>> every_message() {
+  std::vector<std::pair<std::string, std::vector<std::uint8_t>>> out;
+  auto add = [&](const std::string& name, auto&& append) {
+    std::vector<std::uint8_t> payload;
+    const auto status = append(payload);
+    EXPECT_TRUE(status.ok()) << name;
+    out.emplace_back(name, std::move(payload));
+  };
+  rtcm3::StationPosition s;
+  s.station_id = 2003;
+  s.itrf_year = 20;
+  s.glonass = false;
+  s.reference_station = true;
+  s.arp_E_m = {1114104.5999, -4850729.7108, 3975521.4643};
+  s.single_oscillator = true;
+  s.quarter_cycle = 1;
+  add("1005", [&](auto& p) { return rtcm3::append_station_position(s, p); });
+  s.antenna_height_m = 1.2345;
+  add("1006", [&](auto& p) { return rtcm3::append_station_position(s, p); });
+  rtcm3::AntennaInfo a;
+  a.station_id = 17;
+  a.antenna_descriptor = "TRM59800.00     SCIS";
+  a.antenna_setup_id = 3;
+  a.antenna_serial = "12345";
+  a.receiver_type = "canyon";
+  a.receiver_firmware = "0.1.0";
+  a.receiver_serial = "X1";
+  add("1033", [&](auto& p) { return rtcm3::append_antenna_info(a, p); });
+  rtcm3::GlonassBiases b;
+  b.station_id = 9;
+  b.aligned = true;
+  b.bias_m = {1.22, std::nullopt, -3.5, 0.0};
+  add("1230", [&](auto& p) { return rtcm3::append_glonass_biases(b, p); });
+  const GpsTime toe{2176, 288000.0};
+  for (const core::SatelliteId sat :
+       {core::SatelliteId{Constellation::Gps, 5}, core::SatelliteId{Constellation::Qzss, 3},
+        core::SatelliteId{Constellation::BeiDou, 30}, core::SatelliteId{Constellation::Galileo, 11}}) {
+    for (const int source : {0x205, 0x102}) {
+      if (source == 0x102 && sat.system != Constellation::Galileo) continue;
+      core::KeplerEphemeris e = typical_kepler(sat, sat.system == Constellation::BeiDou ? toe + 14.0 : toe);
+      if (sat.system == Constellation::Galileo) {
+        e.data_source = source;
+        e.health = 0x1B5;
+      }
+      if (sat.system == Constellation::Gps) e.fit_interval_h = 6.0;
+      add(std::to_string(rtcm3::ephemeris_message_number(e)) + " " + sat.to_string(),
+          [&](auto& p) { return rtcm3::append_kepler_ephemeris(e, p); });
+    }
+  }
+  core::GlonassEphemeris g;
+  g.sat = core::SatelliteId{Constellation::Glonass, 7};
+  g.frequency_channel = -4;
+  g.health = 1;
+  g.toe = GpsTime{2176, 2 * 86400.0 + 20 * 3600.0 + 45 * 60.0 + 18.0};
+  g.frame_time = g.toe - 900.0 + 30.0;
+  g.p_E_m = {12345678.9, -19876543.2, 7654321.0};
+  g.v_E_mps = {1234.5678, 456.789, -3210.987};
+  g.a_E_mps2 = {1.8626e-6, -9.3132e-7, 0.0};
+  g.tau_n_s = 2.345e-5;
+  g.gamma_n = 1.8190e-12;
+  g.delta_tau_n_s = -2.79e-9;
+  g.age_days = 3;
+  add("1020", [&](auto& p) { return rtcm3::append_glonass_ephemeris(g, core::builtin_leap_seconds(), p); });
+  std::mt19937_64 rng(11);
+  for (const int type : {4, 5, 6, 7}) {
+    for (const Constellation c : {Constellation::Gps, Constellation::Glonass, Constellation::Galileo,
+                                  Constellation::Qzss, Constellation::BeiDou}) {
+      const rtcm3::MsmMessage m = random_msm(rng, c, type, 12, 4);
+      add(std::to_string(rtcm3::msm_message_number(c, type)), [&](auto& p) { return rtcm3::append_msm(m, p); });
+    }
+  }
+  return out;
+}
+
+TEST(Rtcm3Fields, EveryMessageEncodesToTheBytesItAlwaysHad) {
+  // Size and CRC-24Q of each payload as the encoders wrote them before the layouts were shared (commit 0443c6d).
+  struct Recorded {
+    const char* name;
+    std::size_t size;
+    std::uint32_t crc;
+  };
+  const Recorded recorded[] = {
+      {"1005", 19, 0xBC8C12},     {"1006", 21, 0x25EC8E},     {"1033", 47, 0xE6CABF},     {"1230", 10, 0xCD6586},
+      {"1019 G05", 61, 0xAF2931}, {"1044 J03", 61, 0x3FD35C}, {"1042 C30", 64, 0x7ED012}, {"1046 E11", 63, 0x729C1E},
+      {"1045 E11", 62, 0x1ADA24}, {"1020", 45, 0xE0F94E},     {"1074", 319, 0xB28547},    {"1084", 319, 0x87881B},
+      {"1094", 319, 0xFA79B2},    {"1114", 319, 0x5BBE68},    {"1124", 319, 0xEDEE37},    {"1075", 428, 0x9FCC29},
+      {"1085", 428, 0x95BC1E},    {"1095", 428, 0x475E2E},    {"1115", 428, 0xCEB256},    {"1125", 428, 0x9CEF53},
+      {"1076", 412, 0x40199E},    {"1086", 412, 0xA186B2},    {"1096", 412, 0x34E076},    {"1116", 412, 0x4B4700},
+      {"1126", 412, 0xFAA31D},    {"1077", 522, 0xC70941},    {"1087", 522, 0xDA93FE},    {"1097", 522, 0x67A100},
+      {"1117", 522, 0xF9D4B8},    {"1127", 522, 0x5C85FC},
+  };
+  const auto messages = every_message();
+  ASSERT_EQ(messages.size(), std::size(recorded));
+  for (std::size_t i = 0; i < messages.size(); ++i) {
+    const auto& [name, payload] = messages[i];
+    EXPECT_EQ(name, recorded[i].name);
+    EXPECT_EQ(payload.size(), recorded[i].size) << name;
+    EXPECT_EQ(crc24q(payload), recorded[i].crc) << name;
+  }
+}
+
+TEST(Rtcm3Fields, EveryMessageDecodesAndEncodesBackToItsBytes) {
+  const GpsTime reference{2176, 288000.0 + 7200.0};
+  const core::LeapSecondTable leaps = core::builtin_leap_seconds();
+  for (const auto& [name, payload] : every_message()) {
+    SCOPED_TRACE(name);
+    std::vector<std::uint8_t> again;
+    const int number = rtcm3::message_number(payload);
+    if (number == 1005 || number == 1006) {
+      ASSERT_TRUE(rtcm3::append_station_position(*rtcm3::decode_station_position(payload), again).ok());
+    } else if (number == 1033) {
+      ASSERT_TRUE(rtcm3::append_antenna_info(*rtcm3::decode_antenna_info(payload), again).ok());
+    } else if (number == 1230) {
+      ASSERT_TRUE(rtcm3::append_glonass_biases(*rtcm3::decode_glonass_biases(payload), again).ok());
+    } else if (number == 1020) {
+      const auto g = rtcm3::decode_glonass_ephemeris(payload, GpsTime{2176, 2 * 86400.0 + 20 * 3600.0}, leaps);
+      ASSERT_TRUE(g.ok()) << g.error().to_string();
+      ASSERT_TRUE(rtcm3::append_glonass_ephemeris(*g, leaps, again).ok());
+    } else if (rtcm3::msm_kind(number)) {
+      const auto m = rtcm3::decode_msm(payload);
+      ASSERT_TRUE(m.ok()) << m.error().to_string();
+      ASSERT_TRUE(rtcm3::append_msm(*m, again).ok());
+    } else {
+      const auto e = rtcm3::decode_kepler_ephemeris(payload, reference);
+      ASSERT_TRUE(e.ok()) << e.error().to_string();
+      ASSERT_TRUE(rtcm3::append_kepler_ephemeris(*e, again).ok());
+    }
+    EXPECT_EQ(again, payload);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -38,21 +38,35 @@ namespace canyon::io {
   return (word << skip) >> (64 - n);
 }
 
-/// Two's complement field of `n` bits (2 <= n <= 64).
-[[nodiscard]] inline std::int64_t get_bits_signed(const std::uint8_t* data, std::size_t size, std::size_t pos,
-                                                  unsigned n) {
-  const std::uint64_t u = get_bits(data, size, pos, n);
+/// The value of an `n`-bit two's complement pattern (2 <= n <= 64).
+[[nodiscard]] inline std::int64_t twos_complement_value(std::uint64_t u, unsigned n) {
   if (n == 64) return static_cast<std::int64_t>(u);
   const std::uint64_t sign = std::uint64_t{1} << (n - 1);
   return static_cast<std::int64_t>(u ^ sign) - static_cast<std::int64_t>(sign);
 }
 
+/// The value of an `n`-bit sign-magnitude pattern (GLONASS): the first bit is the sign.
+[[nodiscard]] inline std::int64_t sign_magnitude_value(std::uint64_t u, unsigned n) {
+  const std::uint64_t magnitude = u & ((std::uint64_t{1} << (n - 1)) - 1);
+  return (u >> (n - 1)) != 0 ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
+}
+
+/// Two's complement field of `n` bits (2 <= n <= 64).
+[[nodiscard]] inline std::int64_t get_bits_signed(const std::uint8_t* data, std::size_t size, std::size_t pos,
+                                                  unsigned n) {
+  return twos_complement_value(get_bits(data, size, pos, n), n);
+}
+
 /// Sign-magnitude field of `n` bits (GLONASS): the first bit is the sign.
 [[nodiscard]] inline std::int64_t get_bits_sign_magnitude(const std::uint8_t* data, std::size_t size, std::size_t pos,
                                                           unsigned n) {
-  const std::uint64_t u = get_bits(data, size, pos, n);
-  const std::uint64_t magnitude = u & ((std::uint64_t{1} << (n - 1)) - 1);
-  return (u >> (n - 1)) != 0 ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
+  return sign_magnitude_value(get_bits(data, size, pos, n), n);
+}
+
+/// The `n`-bit sign-magnitude pattern of `value` (GLONASS): sign bit, then |value| in n - 1 bits (not masked).
+[[nodiscard]] inline std::uint64_t sign_magnitude_bits(std::int64_t value, unsigned n) {
+  const std::uint64_t magnitude = static_cast<std::uint64_t>(value < 0 ? -value : value);
+  return ((value < 0 ? std::uint64_t{1} : 0) << (n - 1)) | magnitude;
 }
 
 /// Sequential reader over a message.
@@ -121,10 +135,7 @@ class BitWriter {
   /// Two's complement; the caller checks the range.
   void s(std::int64_t value, unsigned n) { u(static_cast<std::uint64_t>(value), n); }
   /// Sign-magnitude (GLONASS): sign bit, then |value| in n - 1 bits.
-  void sm(std::int64_t value, unsigned n) {
-    const std::uint64_t magnitude = static_cast<std::uint64_t>(value < 0 ? -value : value);
-    u(((value < 0 ? std::uint64_t{1} : 0) << (n - 1)) | magnitude, n);
-  }
+  void sm(std::int64_t value, unsigned n) { u(sign_magnitude_bits(value, n), n); }
   /// Writes the partial last byte (zero-padded) into the vector; further writes start a new byte.
   void flush() {
     if (pending_ > 0) {
