@@ -120,8 +120,8 @@ void FusionEstimator::resolve(EpochItem& item) {
   fusion::FusionEpoch epoch = engine_.finish_epoch();
   EpochOutput out = output_of(epoch, epoch.rtk);
   out.aided = epoch.aided;
-  if (!engine_.stats().alignments.empty()) {
-    const fusion::AlignmentEvent& a = engine_.stats().alignments.back();
+  if (!engine_.stats().alignment.events.empty()) {
+    const fusion::AlignmentEvent& a = engine_.stats().alignment.events.back();
     out.alignment = EpochOutput::Alignment{a.kind, a.rmse_m, a.first_eigenvalue_ratio, engine_.lever_arm_m()};
   }
   item.output = std::move(out);

@@ -15,8 +15,8 @@ namespace canyon::rtk {
 
 AmbiguityResolver::AmbiguityResolver(const RtkOptions& options)
     : options_(options),
-      consistency_z_(options.float_consistency_level > 0.0 ? core::normal_upper_quantile(options.float_consistency_level)
-                                                            : 0.0) {}
+      consistency_z_(
+          options.float_consistency_level > 0.0 ? core::normal_upper_quantile(options.float_consistency_level) : 0.0) {}
 
 FixSearch AmbiguityResolver::search(const FilterState& state, const std::vector<SingleDiff>& sds) {
   return FixSearch(*this, state, sds);

@@ -141,8 +141,7 @@ struct RowsUsed {
 
 /// One Kalman update with the gated rows and its post-fit check.
 RowsUsed update_once(FilterState& state, std::vector<SingleDiff>& sds, const RtkOptions& options,
-                                const InnovationGate* gate, std::vector<core::SatelliteId>& rejected,
-                                PostFit& post_fit) {
+                     const InnovationGate* gate, std::vector<core::SatelliteId>& rejected, PostFit& post_fit) {
   const std::vector<DdRow> rows = gated_rows(state, sds, options, gate, rejected);
   if (rows.empty()) return {};
   // The code rows, which touch only the position (and ionosphere states), in compressed form, then the phase rows at

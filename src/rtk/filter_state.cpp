@@ -68,8 +68,8 @@ void FilterState::clear_keyed() {
   keys_.clear();
 }
 
-void FilterState::reset_kinematics(const Eigen::Vector3d& p_E_m, const Eigen::Vector3d& v_E_mps,
-                                   double var_position_m2, double var_kinematics) {
+void FilterState::reset_kinematics(const Eigen::Vector3d& p_E_m, const Eigen::Vector3d& v_E_mps, double var_position_m2,
+                                   double var_kinematics) {
   const int k = num_unkeyed();
   P_.topRows(k).setZero();
   P_.leftCols(k).setZero();

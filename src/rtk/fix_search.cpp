@@ -172,8 +172,7 @@ void FixSearch::conclude(FixCandidate candidate, bool accepted) {
       if (!accepted || !candidate.position_ok) return;
       // A few precise combinations need not pin the position down: the fix counts only if they do (otherwise the
       // float position conditioned on them is still the better float).
-      candidate.imprecise =
-          !(std::sqrt(std::max(candidate.P_E_m2.trace(), 0.0)) <= options.max_partial_fix_sigma_m);
+      candidate.imprecise = !(std::sqrt(std::max(candidate.P_E_m2.trace(), 0.0)) <= options.max_partial_fix_sigma_m);
       if (!candidate.imprecise) return finish(std::move(candidate));
       imprecise_ = std::move(candidate);
       return;
@@ -281,10 +280,10 @@ std::optional<FixCandidate> FixSearch::prune_step() {
   for (std::size_t k = 0; k < fix.dd.size(); ++k) {
     per_satellite[satellite_of_state(fix.dd[k].first)] += (*contributions)[static_cast<Eigen::Index>(k)];
   }
-  const core::SatelliteId worst = std::max_element(per_satellite.begin(), per_satellite.end(), [](const auto& l,
-                                                                                                const auto& r) {
-                                    return l.second < r.second;
-                                  })->first;
+  const core::SatelliteId worst =
+      std::max_element(per_satellite.begin(), per_satellite.end(), [](const auto& l, const auto& r) {
+        return l.second < r.second;
+      })->first;
   std::vector<DdPair> dd = fix.dd;
   dd.erase(std::remove_if(dd.begin(), dd.end(), [&](const DdPair& p) { return satellite_of_state(p.first) == worst; }),
            dd.end());

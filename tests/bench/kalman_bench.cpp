@@ -41,7 +41,7 @@ Problem make_problem(int states, int satellites, unsigned seed) {
     DdRow phase = code;
     phase.phase = true;
     phase.add(4 + r % (states - 4), 0.19);  // satellite s's ambiguity
-    phase.add(3, -0.19);                     // the reference's
+    phase.add(3, -0.19);                    // the reference's
     p.code.push_back(code);
     p.phase.push_back(phase);
   }

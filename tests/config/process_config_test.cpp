@@ -65,13 +65,13 @@ fusion: {gate: chi_square, prediction: constant_velocity, lever_arm_prior_m: [0.
   EXPECT_EQ(config->mode, ProcessMode::Fusion);
   EXPECT_EQ(config->vio, "vio.csv");
   EXPECT_EQ(config->timesync, "sync/timesync.csv");
-  EXPECT_EQ(config->fusion.gate, fusion::InnovationGate::ChiSquare);
-  EXPECT_EQ(config->fusion.prediction, fusion::Prediction::ConstantVelocity);
-  EXPECT_DOUBLE_EQ(config->fusion.lever_arm_prior_m.z(), 0.12);
-  EXPECT_DOUBLE_EQ(config->fusion.alignment.max_rmse_m, 0.05);
+  EXPECT_EQ(config->fusion.gates.kind, fusion::GateKind::ChiSquare);
+  EXPECT_EQ(config->fusion.prediction.kind, fusion::Prediction::ConstantVelocity);
+  EXPECT_DOUBLE_EQ(config->fusion.alignment.lever_arm_prior_m.z(), 0.12);
+  EXPECT_DOUBLE_EQ(config->fusion.alignment.fit.max_rmse_m, 0.05);
   EXPECT_TRUE(config->fusion.vio_on_gps_time);
   EXPECT_TRUE(config->fusion.cn0.enabled);
-  EXPECT_FALSE(config->fusion.false_fix_guard);
+  EXPECT_FALSE(config->fusion.guard.enabled);
   auto again = parse_process_config(YAML::Load(to_yaml(*config)), "");
   ASSERT_TRUE(again.ok()) << again.error().to_string();
   EXPECT_EQ(*again, *config);

@@ -590,7 +590,7 @@ TEST(FusionGeometryTest, BuiltAheadGivesTheEpochsOfTheEnginesOwnGeometry) {
   rtk::RtkOptions rtk_options;
   rtk_options.ionosphere = rtk::IonosphereModel::Estimate;
   FusionOptions options;
-  options.coarse_min_spread_m = 5.0;  // the former bound: the test needs unaligned epochs (their verdicts unapplied)
+  options.coarse.min_spread_m = 5.0;  // the former bound: the test needs unaligned epochs (their verdicts unapplied)
   const VioTrack track =
       VioTrack::from_samples(track_samples(sim->vio.poses, simulated->scenario.start), simulated->scenario.start);
   FusionEngine own(options, rtk_options, eph, sim->base_p_E_m, track);
@@ -690,7 +690,7 @@ TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCa
   // urban-severe, seed 2: the walk starts in the canyon, no window passes the paper's gates (a straight street), and
   // the coarse alignment fitted to metre-level float solutions is off by degrees. Without the heading state the fill-in
   // drifts sideways by that angle of the distance walked; with it the updates teach the filter the error.
-  const auto runs = with_and_without(2, 300.0, "heading", [](FusionOptions& o) { o.heading_state = false; });
+  const auto runs = with_and_without(2, 300.0, "heading", [](FusionOptions& o) { o.heading.enabled = false; });
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
   const double folded_deg = with.stats.heading_folded_rad * core::kRadToDeg;
@@ -707,7 +707,7 @@ TEST(FusionIntegrityTest, AnOutputThatLeftTheSinglePointsStartsAgainFromThem) {
   // urban-severe, seed 22: without the check the VIO carries the output hundreds of metres away from the single points
   // (380 m RMSE over the 600 s). The integrity check moves it back to them (twice; it restarts the ambiguities and the
   // heading too); without it the error stays.
-  const auto runs = with_and_without(22, 600.0, "integrity", [](FusionOptions& o) { o.integrity_check = false; });
+  const auto runs = with_and_without(22, 600.0, "integrity", [](FusionOptions& o) { o.integrity.enabled = false; });
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
   std::printf("urban-severe seed 22, 600 s: 3D RMSE %.1f m with the integrity check (%d restarts), %.1f m without\n",
@@ -724,7 +724,7 @@ TEST(FusionHeadingFreeTest, AStartInTheCanyonHasASolutionAtEveryEpoch) {
   // has one (the last solution moved by the VIO's vertical motion, its sigma the distance travelled), and no other
   // epoch changes.
   const auto runs =
-      with_and_without(10, 600.0, "heading-free", [](FusionOptions& o) { o.heading_free_fill_in = false; });
+      with_and_without(10, 600.0, "heading-free", [](FusionOptions& o) { o.heading_free.enabled = false; });
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
   std::printf(

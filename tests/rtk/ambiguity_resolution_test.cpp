@@ -17,9 +17,8 @@ using testing::synthetic_epoch;
 /// Floats a few hundredths of a cycle from the true integers, precise (sigma 0.02 cycles), satellite `biased` (if
 /// any) half a cycle off.
 testing::SyntheticEpoch floats(int count, int biased = -1) {
-  return synthetic_epoch(count, Eigen::Vector3d::Zero(), 1e-4, 4e-4, [biased](int i, int integer) {
-    return integer + (i == biased ? 0.5 : 0.01 * ((i % 3) - 1));
-  });
+  return synthetic_epoch(count, Eigen::Vector3d::Zero(), 1e-4, 4e-4,
+                         [biased](int i, int integer) { return integer + (i == biased ? 0.5 : 0.01 * ((i % 3) - 1)); });
 }
 
 /// Runs the search, deciding with `decide`; the number of candidates proposed.
@@ -120,8 +119,7 @@ TEST(AmbiguityResolution, AFixThatContradictsTheLastOneIsNotProposedAndHoldCondi
   }
   EXPECT_EQ(resolver.last_fix().size(), 7U);
   const int index = e.state.index({e.sds[2].sat, 0});
-  EXPECT_NEAR(e.state.x()[index] - e.state.x()[e.state.index({e.sds[0].sat, 0})], e.integers[2] - e.integers[0],
-              1e-3);
+  EXPECT_NEAR(e.state.x()[index] - e.state.x()[e.state.index({e.sds[0].sat, 0})], e.integers[2] - e.integers[0], 1e-3);
   EXPECT_LT(e.state.P()(index, index), 4e-4);  // held
   // The same satellites a cycle apart: every DD of satellite 3 contradicts the held integers.
   testing::SyntheticEpoch shifted = floats(8);

@@ -81,9 +81,8 @@ TEST(DdUpdate, FixedLimitsAndAnInjectedGateDropRowsAndTheirAmbiguitiesAreNotFixe
   RtkOptions options;
   options.max_phase_innovation_m = 1.0;  // rows whose geometry alone moves them more than 1 m
   std::vector<DdRow> rows = dd_rows(e.state, e.sds);
-  const auto beyond = static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const DdRow& row) {
-    return row.phase && std::abs(row.innovation_m) > 1.0;
-  }));
+  const auto beyond = static_cast<int>(std::count_if(
+      rows.begin(), rows.end(), [](const DdRow& row) { return row.phase && std::abs(row.innovation_m) > 1.0; }));
   ASSERT_GT(beyond, 0);
   std::vector<core::SatelliteId> rejected;
   const DdUpdateResult r = dd_measurement_update(e.state, e.sds, options, nullptr, rejected);
@@ -109,7 +108,8 @@ TEST(DdUpdate, FixedLimitsAndAnInjectedGateDropRowsAndTheirAmbiguitiesAreNotFixe
   EXPECT_EQ(refuse_all.asked, 14);
   EXPECT_EQ(rejected.size(), 14U);
   EXPECT_EQ(f.state.x(), x0);
-  EXPECT_TRUE(std::none_of(f.sds.begin(), f.sds.end(), [](const SingleDiff& sd) { return sd.fixable && sd.sat.prn > 1; }));
+  EXPECT_TRUE(
+      std::none_of(f.sds.begin(), f.sds.end(), [](const SingleDiff& sd) { return sd.fixable && sd.sat.prn > 1; }));
 }
 
 }  // namespace

@@ -73,7 +73,8 @@ TEST(Kalman, CodeThenPhaseEqualsTheJointUpdate) {
     auto step1 = compressed_update(P, code_rows, v_code, R_code);
     ASSERT_TRUE(step1.has_value());
     Eigen::VectorXd v2(5);
-    for (int a = 0; a < 5; ++a) v2[a] = phase[static_cast<std::size_t>(a)].innovation_m - phase[static_cast<std::size_t>(a)].dot(step1->dx);
+    for (int a = 0; a < 5; ++a)
+      v2[a] = phase[static_cast<std::size_t>(a)].innovation_m - phase[static_cast<std::size_t>(a)].dot(step1->dx);
     auto step2 = dense_update(P, *step1, phase_rows, v2, R_phase);
     ASSERT_TRUE(step2.has_value());
     const Eigen::VectorXd dx = step1->dx + step2->dx;

@@ -60,7 +60,7 @@ TEST(TimeUpdate, AnExternalMotionAddsItsIncrementAndRestartsTheHeadingWhenAskedO
   EXPECT_NEAR(state.P()(h, h), 0.01 + 1e-6, 1e-15);
   EXPECT_LT((state.position_E_m() - (kPosition + m.delta_p_E_m)).norm(), 1e-9);
   EXPECT_NEAR(state.P()(1, 1), 1.0 + 1e-4 + 0.25 * 0.01, 1e-12);  // J var J^T on the position
-  external_motion_update(state, m, live);  // live and not asked: the heading goes on
+  external_motion_update(state, m, live);                         // live and not asked: the heading goes on
   EXPECT_NEAR(state.P()(h, h), 0.01 + 2e-6, 1e-15);
   m.restart_heading = true;
   m.heading_variance_rad2 = 0.04;

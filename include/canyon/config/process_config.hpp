@@ -37,7 +37,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "canyon/core/result.hpp"
-#include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/fusion/fusion_options.hpp"
 #include "canyon/gnss/spp.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/rtk/engine.hpp"

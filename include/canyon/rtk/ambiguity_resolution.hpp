@@ -10,8 +10,8 @@
 //     min_success_rate (the ratio test alone accepts wrong single-frequency, single-epoch fixes),
 //   - no DD ambiguity also fixed at the last fix (no slip since) gets another integer.
 // Float consistency (float_consistency_level > 0): with a right model and right integers,
-// (a_float - a)^T Q_a^-1 (a_float - a) is chi-square with n degrees of freedom; when even the best integer vector of the
-// full set leaves a squared norm beyond that quantile, no integer vector fits the float, whose covariance is too
+// (a_float - a)^T Q_a^-1 (a_float - a) is chi-square with n degrees of freedom; when even the best integer vector of
+// the full set leaves a squared norm beyond that quantile, no integer vector fits the float, whose covariance is too
 // optimistic (reflections, multipath correlated over minutes). The epoch's success rates are then computed with Q_a
 // scaled by k = norm / n (the ratio test does not see k).
 //
@@ -24,7 +24,7 @@
 //      set's search, the longest trailing run of levels whose bootstrapped success rate stays >= min_success_rate,
 //      fixed as integer combinations; if it leaves the position less precise than max_partial_fix_sigma_m (3D sigma)
 //      it is no fix but conditions the float ("imprecise"), and the search goes on;
-//   5. the paper's pruning (Algorithm 1, lines 13-19): the satellite whose DD ambiguities contribute most to the
+//   5. the paper's pruning (Algorithm 1, lines 13-14): the satellite whose DD ambiguities contribute most to the
 //      integer least-squares residual of the best candidate is dropped, and the rest searched again, at most
 //      max_pruned_satellites times;
 //   6. without each (constellation, frequency) group, then without each constellation that has several (signals two
@@ -64,10 +64,10 @@ struct FixCandidate {
   Eigen::MatrixXd PDt;    ///< P D^T
   Eigen::VectorXd a_fix;  ///< best integer candidate
   double ratio = 0.0;
-  double squared_norm = 0.0;  ///< (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
-  double success_rate = 0.0;  ///< bootstrapped success rate of the float model
-  Eigen::MatrixXd Z;          ///< the search's decorrelation: Z^T Q_a Z = L^T diag(d) L
-  Eigen::VectorXd d;          ///< its conditional variances (cycles^2)
+  double squared_norm = 0.0;              ///< (a_float - a_fix)^T Q_a^-1 (a_float - a_fix) of the best candidate
+  double success_rate = 0.0;              ///< bootstrapped success rate of the float model
+  Eigen::MatrixXd Z;                      ///< the search's decorrelation: Z^T Q_a Z = L^T diag(d) L
+  Eigen::VectorXd d;                      ///< its conditional variances (cycles^2)
   std::vector<core::SatelliteId> pruned;  ///< satellites pruned by their ILS residual to get this set
   /// The fixed quantities are integer combinations Z_S^T of the DD ambiguities dd (a_float = Z_S^T D x,
   /// PDt = P D^T Z_S) rather than the DD ambiguities themselves: a partial fix by the success rate.
@@ -154,8 +154,16 @@ class FixSearch {
   friend class AmbiguityResolver;
   FixSearch(AmbiguityResolver& resolver, const FilterState& state, const std::vector<SingleDiff>& sds);
 
-  enum class Step { RetryLastSubset, FullSet, LastSubset, SuccessRateSubset, PruneFullSet, Exclusions, PruneRejected,
-                    Done };
+  enum class Step {
+    RetryLastSubset,
+    FullSet,
+    LastSubset,
+    SuccessRateSubset,
+    PruneFullSet,
+    Exclusions,
+    PruneRejected,
+    Done
+  };
   enum class Pruning { FullSet, Rejected };
   /// The current step's next candidate, or nullopt when the step moved on without one.
   std::optional<FixCandidate> advance();
@@ -187,7 +195,7 @@ class FixSearch {
   Step step_ = Step::Done;
   std::vector<DdPair> all_;  // the full set
   std::vector<AmbiguityResolver::DdKey> all_keys_;
-  int min_size_ = 0;              // a subset keeps at least min_partial_fraction of the ambiguities
+  int min_size_ = 0;                // a subset keeps at least min_partial_fraction of the ambiguities
   bool last_subset_tried_ = false;  // step 1 ran (and failed): step 3 would search the same set again
   std::optional<FixCandidate> full_;
   std::optional<FixCandidate> pending_;  // proposed, awaiting decide()

@@ -30,8 +30,7 @@ class AmbiguityStates {
   /// ambiguity and SingleDiff::fixable set.
   [[nodiscard]] std::vector<FilterState::NewState> admit(std::vector<SingleDiff>& sds, const FilterState& state,
                                                          const core::GpsTime& t, const SlipScan& slips,
-                                                         const RtkOptions& options,
-                                                         std::optional<double> iono_sigma_m);
+                                                         const RtkOptions& options, std::optional<double> iono_sigma_m);
 
  private:
   struct Info {

@@ -34,8 +34,9 @@ struct KalmanStep {
 [[nodiscard]] KalmanStep no_step(Eigen::Index n);
 
 /// Update with rows that touch few states, in compressed form (see above). nullopt if S is not positive definite.
-[[nodiscard]] std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P, const std::vector<const DdRow*>& rows,
-                                                          Eigen::VectorXd v, const Eigen::MatrixXd& R);
+[[nodiscard]] std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P,
+                                                          const std::vector<const DdRow*>& rows, Eigen::VectorXd v,
+                                                          const Eigen::MatrixXd& R);
 
 /// Update with rows that touch most states, at the covariance P - prior.U prior.V^T of a preceding step not applied
 /// yet (see above). nullopt if S is not positive definite.

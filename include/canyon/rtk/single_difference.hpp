@@ -59,7 +59,8 @@ struct SingleDiff {
 /// The epoch's single differences at the rover position `p_E_rover_m` (the filter's prior), ordered by satellite and
 /// frequency; the rover's satellite states are added to the geometry's (shared with its single-point solution).
 /// `iono_estimated`: fill iono_scale for the ionosphere states.
-[[nodiscard]] std::vector<SingleDiff> form_single_differences(EpochGeometry& geometry, const Eigen::Vector3d& p_E_rover_m,
+[[nodiscard]] std::vector<SingleDiff> form_single_differences(EpochGeometry& geometry,
+                                                              const Eigen::Vector3d& p_E_rover_m,
                                                               const RtkOptions& options,
                                                               const gnss::EphemerisStore& eph, bool iono_estimated);
 

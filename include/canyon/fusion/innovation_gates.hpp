@@ -1,0 +1,44 @@
+#pragma once
+// Outlier satellite pruning in the measurement update (the paper's Section "Outlier Satellite Pruning"; Algorithm 1,
+// line 6), as the RTK filter's injected gate policy (rtk::InnovationGate, rtk/dd_update.hpp):
+//   the paper's gate: a DD phase innovation beyond motion_factor x |dp_E| (5 x the VIO incremental motion, at least
+//     min_gate_m) is not used. Applied to phase only (DD code noise is of that size), and only to rows whose
+//     predicted sigma sqrt(h P h^T) is within a third of the gate (a new ambiguity's prediction is no test);
+//   beyond the paper, a chi-square gate on phase and code: |v| <= sigmas sqrt(h P h^T + r).
+
+#include <optional>
+#include <string>
+
+#include "canyon/rtk/dd_update.hpp"
+
+namespace canyon::fusion {
+
+enum class GateKind { Off, Paper, ChiSquare, Both };
+[[nodiscard]] const char* gate_kind_name(GateKind kind);
+
+struct GateOptions {
+  GateKind kind = GateKind::Both;
+  double motion_factor = 5.0;  ///< paper: 5 x the VIO incremental motion
+  double min_gate_m = 0.5;     ///< the motion gate is at least this (standing still) (m)
+  double sigmas = 4.0;         ///< chi-square gate: |v| <= this x sqrt(h P h^T + r)
+
+  [[nodiscard]] std::string validate() const;
+};
+
+/// One epoch's gates.
+class VioInnovationGates final : public rtk::InnovationGate {
+ public:
+  VioInnovationGates() = default;
+  /// The gates of an epoch whose predicted motion is `motion_m` long.
+  VioInnovationGates(const GateOptions& options, double motion_m);
+  [[nodiscard]] bool passes(const rtk::DdInnovation& row) const override;
+
+  [[nodiscard]] const std::optional<double>& max_phase_innovation_m() const { return max_phase_innovation_m_; }
+  [[nodiscard]] const std::optional<double>& max_normalised_innovation() const { return max_normalised_innovation_; }
+
+ private:
+  std::optional<double> max_phase_innovation_m_;     // the paper's gate (m)
+  std::optional<double> max_normalised_innovation_;  // the chi-square gate (sigmas)
+};
+
+}  // namespace canyon::fusion

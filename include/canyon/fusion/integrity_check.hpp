@@ -1,0 +1,61 @@
+#pragma once
+// Beyond the paper: an integrity check of the output against the single points. Why: the fusion can carry a wrong
+// position along for minutes (an alignment to solutions far off, NLOS floats that pulled it away) with nothing in its
+// own tests to see it. The horizontal offset of each aided epoch's single-point solution from the output, in local
+// east and north, is kept over window_s; when the median offset (per axis) of at least min_points of them exceeds
+// max_offset_m, the position moves horizontally by that median (the single points' spread about it as its variance;
+// the vertical and the alignment stay), every ambiguity starts again and so does the heading error (at least 10 deg).
+// Single points in street canyons are tens of metres off for tens of seconds at a time (a 30 s median up to 43 m on
+// urban-severe), hence a median over a window and a bound above that.
+
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "canyon/core/time.hpp"
+
+namespace canyon::fusion {
+
+struct IntegrityCheckOptions {
+  bool enabled = true;
+  double window_s = 30.0;      ///< the window of aided epochs (s)
+  int min_points = 50;         ///< single points the window needs before it judges
+  double max_offset_m = 60.0;  ///< median horizontal offset of the single points beyond which it restarts (m)
+
+  [[nodiscard]] std::string validate() const;
+};
+
+/// A restart from the single points.
+struct IntegrityRestart {
+  Eigen::Vector3d p_E_m;   ///< the output moved horizontally by the median offset
+  Eigen::Matrix3d P_E_m2;  ///< the single points' spread horizontally, the output's vertical variance
+  double offset_m = 0.0;   ///< the median offset's length
+};
+
+class IntegrityCheck {
+ public:
+  explicit IntegrityCheck(const IntegrityCheckOptions& options) : options_(options) {}
+  /// An aided epoch's output `p_out_E_m` (covariance `P_out_E_m2`) and its single point, if any: the restart, when the
+  /// window says so (then the window starts again).
+  [[nodiscard]] std::optional<IntegrityRestart> check(const core::GpsTime& t, const Eigen::Vector3d& p_out_E_m,
+                                                      const Eigen::Matrix3d& P_out_E_m2,
+                                                      const std::optional<Eigen::Vector3d>& spp_p_E_m);
+  /// An epoch that was not aided (or had no output): the window starts again.
+  void clear() { offsets_.clear(); }
+
+ private:
+  struct Offset {
+    core::GpsTime time;
+    Eigen::Vector2d d_EN_m;  // single point minus output, local east and north (m)
+  };
+  [[nodiscard]] double median_offset_m(int axis);
+
+  IntegrityCheckOptions options_;
+  std::deque<Offset> offsets_;
+  std::vector<double> scratch_m_;  // the medians' working copy (kept: no allocation per epoch)
+};
+
+}  // namespace canyon::fusion
