@@ -84,17 +84,18 @@ int run(int argc, char** argv) {
   std::unique_ptr<canyon::dds::DdsParticipant> participant;
   std::unique_ptr<canyon::dds::RtcmWriter> writer;
   if (config->dds.enabled) {
-    if (auto s = canyon::dds::load_profiles_or_default(config->dds.profiles); !s.ok()) {
+    if (auto s = canyon::dds::load_profiles(config->dds.profiles); !s.ok()) {
       spdlog::error("{}", s.error().to_string());
       return kExitUsage;
     }
-    auto p = canyon::dds::DdsParticipant::create(config->dds.domain);
+    auto p = canyon::dds::DdsParticipant::create(
+        config->dds.domain, canyon::dds::load_profiles(config->dds.profiles)->participant_profile());
     if (!p) {
       spdlog::error("{}", p.error().to_string());
       return kExitRuntime;
     }
     participant = std::move(*p);
-    auto w = canyon::dds::RtcmWriter::create(*participant, config->dds.topic, "rtcm_writer");
+    auto w = canyon::dds::RtcmWriter::create(*participant, config->dds.topic, canyon::dds::profile::kRtcmWriter);
     if (!w) {
       spdlog::error("{}", w.error().to_string());
       return kExitRuntime;

@@ -164,17 +164,18 @@ Status open_live_vio(const canyon::config::RoverConfig& config, pl::DdsParticipa
   if (const std::string e = options.validate(); !e.empty()) return canyon::Error{"input.vio dds: " + e};
   live = std::make_unique<canyon::pipeline::LiveVio>(engine, options, log_warning);
   canyon::pipeline::LiveVio* feed = live.get();
-  auto p = pl::VioPoseReader::create(participant, config.vio_topic, "vio_reader", [feed](canyon::msg::VioPose&& m) {
-    auto pose = pl::from_msg(m);
-    if (pose) {
-      feed->push_pose(std::move(*pose));
-    } else {
-      spdlog::warn("VIO: {} (sample dropped)", pose.error().message);
-    }
-  });
+  auto p = pl::VioPoseReader::create(participant, config.vio_topic, canyon::dds::profile::kVioReader,
+                                     [feed](canyon::msg::VioPose&& m) {
+                                       auto pose = pl::from_msg(m);
+                                       if (pose) {
+                                         feed->push_pose(std::move(*pose));
+                                       } else {
+                                         spdlog::warn("VIO: {} (sample dropped)", pose.error().message);
+                                       }
+                                     });
   if (!p) return p.error();
   poses = std::move(*p);
-  auto s = pl::TimeSyncReader::create(participant, config.timesync_topic, "vio_reader",
+  auto s = pl::TimeSyncReader::create(participant, config.timesync_topic, canyon::dds::profile::kVioReader,
                                       [feed](canyon::msg::TimeSyncSample&& m) {
                                         auto pair = pl::from_msg(m);
                                         if (pair) {
@@ -258,17 +259,20 @@ int run(int argc, char** argv) {
                                                                                       : shown(config->base_source);
 
   // DDS first: profiles before any participant.
-  if (auto s = pl::load_profiles_or_default(config->profiles); !s.ok()) {
+  if (auto s = pl::load_profiles(config->profiles); !s.ok()) {
     spdlog::error("{}", s.error().to_string());
     return kExitUsage;
   }
-  auto participant = pl::DdsParticipant::create(config->domain);
+  auto participant =
+      pl::DdsParticipant::create(config->domain, pl::load_profiles(config->profiles)->participant_profile());
   if (!participant) {
     spdlog::error("{}", participant.error().to_string());
     return kExitRuntime;
   }
-  auto solution_writer = pl::SolutionWriter::create(**participant, config->solution_topic, "solution_writer");
-  auto timing_writer = pl::TimingWriter::create(**participant, config->timing_topic, "timing_writer");
+  auto solution_writer =
+      pl::SolutionWriter::create(**participant, config->solution_topic, canyon::dds::profile::kSolutionWriter);
+  auto timing_writer =
+      pl::TimingWriter::create(**participant, config->timing_topic, canyon::dds::profile::kTimingWriter);
   if (!solution_writer || !timing_writer) {
     spdlog::error("{}", (!solution_writer ? solution_writer.error() : timing_writer.error()).to_string());
     return kExitRuntime;
@@ -278,8 +282,8 @@ int run(int argc, char** argv) {
   std::unique_ptr<pl::PriorWriter> prior_writer;
   std::unique_ptr<pl::FloatWriter> float_writer;
   if (config->publish_stages) {
-    auto p = pl::PriorWriter::create(**participant, "canyon/prior", "stage_writer");
-    auto f = pl::FloatWriter::create(**participant, "canyon/float", "stage_writer");
+    auto p = pl::PriorWriter::create(**participant, "canyon/prior", canyon::dds::profile::kStageWriter);
+    auto f = pl::FloatWriter::create(**participant, "canyon/float", canyon::dds::profile::kStageWriter);
     if (!p || !f) {
       spdlog::error("{}", (!p ? p.error() : f.error()).to_string());
       return kExitRuntime;
@@ -287,8 +291,8 @@ int run(int argc, char** argv) {
     prior_writer = std::move(*p);
     float_writer = std::move(*f);
     if (est.mode == canyon::config::ProcessMode::Fusion) {
-      auto b = pl::BridgedWriter::create(**participant, "canyon/bridged", "stage_writer");
-      auto a = pl::AlignmentWriter::create(**participant, "canyon/alignment", "stage_writer");
+      auto b = pl::BridgedWriter::create(**participant, "canyon/bridged", canyon::dds::profile::kStageWriter);
+      auto a = pl::AlignmentWriter::create(**participant, "canyon/alignment", canyon::dds::profile::kStageWriter);
       if (!b || !a) {
         spdlog::error("{}", (!b ? b.error() : a.error()).to_string());
         return kExitRuntime;
@@ -305,7 +309,7 @@ int run(int argc, char** argv) {
   std::unique_ptr<pl::RtcmReader> rtcm_reader;
   if (dds_base) {
     auto r = pl::RtcmReader::create(
-        **participant, config->rtcm_topic, "rtcm_reader",
+        **participant, config->rtcm_topic, canyon::dds::profile::kRtcmReader,
         [&base_frames, &base_frames_dropped, &base_frames_bad](canyon::msg::RtcmFrame&& m) {
           auto frame = pl::from_msg(m);
           if (!frame) {

@@ -102,7 +102,7 @@ double json_number(const std::string& text, const std::string& key) {
 }
 
 int inject(canyon::dds::DdsParticipant& participant, const std::string& topic, int count, double wait_s) {
-  auto writer = canyon::dds::RtcmWriter::create(participant, topic, "rtcm_writer");
+  auto writer = canyon::dds::RtcmWriter::create(participant, topic, canyon::dds::profile::kRtcmWriter);
   if (!writer) {
     std::cout << "{\"writer\":false,\"error\":\"" << writer.error().message << "\"}\n";
     return kExitRefused;
@@ -148,7 +148,8 @@ int run(int argc, char** argv) {
   double idle_s = 5.0;
   double wait_s = 20.0;
   cli.add_option("--mode", mode, "subscribe or inject")->check(CLI::IsMember({"subscribe", "inject"}));
-  cli.add_option("--profiles", profiles, "Fast DDS XML profiles (default config/dds/canyon_profiles.xml)")
+  cli.add_option("--profiles", profiles,
+                 "Deployment profiles (transport and discovery) on top of the shipped config/dds/canyon_profiles.xml")
       ->check(CLI::ExistingFile);
   cli.add_option("--domain", domain, "DDS domain")->check(CLI::Range(0, 232));
   cli.add_option("--topic", topic, "topic of RtcmFrame samples");
@@ -168,15 +169,16 @@ int run(int argc, char** argv) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : kExitUsage;
   }
-  if (auto s = canyon::dds::load_profiles_or_default(profiles); !s.ok()) {
-    std::cerr << "canyon-rtcm-probe: " << s.error().to_string() << "\n";
+  const auto loaded = canyon::dds::load_profiles(profiles);
+  if (!loaded) {
+    std::cerr << "canyon-rtcm-probe: " << loaded.error().to_string() << "\n";
     return kExitUsage;
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
   if (mode == "inject") {
-    auto p = canyon::dds::DdsParticipant::create(domain);
+    auto p = canyon::dds::DdsParticipant::create(domain, loaded->participant_profile());
     if (!p) {
       std::cout << "{\"participant\":false,\"error\":\"" << p.error().message << "\"}\n";
       return kExitRefused;
@@ -201,49 +203,51 @@ int run(int argc, char** argv) {
   std::vector<std::unique_ptr<canyon::dds::DdsParticipant>> participants;
   std::vector<std::unique_ptr<canyon::dds::RtcmReader>> dds_readers;
   for (int k = 0; k < readers; ++k) {
-    auto p = canyon::dds::DdsParticipant::create(domain);
+    auto p = canyon::dds::DdsParticipant::create(domain, loaded->participant_profile());
     if (!p) {
       std::cerr << "canyon-rtcm-probe: " << p.error().to_string() << "\n";
       return kExitRuntime;
     }
-    auto r = canyon::dds::RtcmReader::create(**p, topic, "rtcm_reader", [&, k](canyon::msg::RtcmFrame&& m) {
-      const std::int64_t now = unix_now_ns();
-      last_frame_ns.store(canyon::core::pipeline_now_ns());
-      auto f = canyon::dds::from_msg(m);
-      const std::lock_guard lock(mutex);
-      ReaderStats& s = stats[static_cast<std::size_t>(k)];
-      if (!f) {
-        ++s.bad;
-        return;
-      }
-      if (station >= 0 && f->station_id != station) {
-        ++s.foreign;
-        return;
-      }
-      ++s.received;
-      const auto seq = static_cast<std::int64_t>(f->sequence);
-      if (seq == 0 && s.last_seq > 0) {  // a new base run numbers its frames from 0 again
-        ++s.restarts;
-        s.seen.clear();
-        s.last_seq = -1;
-      }
-      if (k == 0 && arrivals_out != nullptr) {
-        *arrivals_out << canyon::core::pipeline_now_ns() << "," << seq << "," << m.send_unix_ns() << "," << now << "\n";
-      }
-      if (!s.seen.insert(f->sequence).second) {
-        ++s.duplicates;
-        return;
-      }
-      if (s.first_seq < 0) s.first_seq = seq;
-      if (seq < s.last_seq) {
-        ++s.out_of_order;
-      } else {
-        if (s.last_seq >= 0 && seq > s.last_seq + 1) s.gaps += static_cast<std::uint64_t>(seq - s.last_seq - 1);
-        s.last_seq = seq;
-      }
-      s.newest_send_unix_ns = std::max(s.newest_send_unix_ns, m.send_unix_ns());
-      s.latency_ms.push_back(static_cast<double>(now - m.send_unix_ns()) * 1e-6);
-    });
+    auto r = canyon::dds::RtcmReader::create(
+        **p, topic, canyon::dds::profile::kRtcmReader, [&, k](canyon::msg::RtcmFrame&& m) {
+          const std::int64_t now = unix_now_ns();
+          last_frame_ns.store(canyon::core::pipeline_now_ns());
+          auto f = canyon::dds::from_msg(m);
+          const std::lock_guard lock(mutex);
+          ReaderStats& s = stats[static_cast<std::size_t>(k)];
+          if (!f) {
+            ++s.bad;
+            return;
+          }
+          if (station >= 0 && f->station_id != station) {
+            ++s.foreign;
+            return;
+          }
+          ++s.received;
+          const auto seq = static_cast<std::int64_t>(f->sequence);
+          if (seq == 0 && s.last_seq > 0) {  // a new base run numbers its frames from 0 again
+            ++s.restarts;
+            s.seen.clear();
+            s.last_seq = -1;
+          }
+          if (k == 0 && arrivals_out != nullptr) {
+            *arrivals_out << canyon::core::pipeline_now_ns() << "," << seq << "," << m.send_unix_ns() << "," << now
+                          << "\n";
+          }
+          if (!s.seen.insert(f->sequence).second) {
+            ++s.duplicates;
+            return;
+          }
+          if (s.first_seq < 0) s.first_seq = seq;
+          if (seq < s.last_seq) {
+            ++s.out_of_order;
+          } else {
+            if (s.last_seq >= 0 && seq > s.last_seq + 1) s.gaps += static_cast<std::uint64_t>(seq - s.last_seq - 1);
+            s.last_seq = seq;
+          }
+          s.newest_send_unix_ns = std::max(s.newest_send_unix_ns, m.send_unix_ns());
+          s.latency_ms.push_back(static_cast<double>(now - m.send_unix_ns()) * 1e-6);
+        });
     if (!r) {
       std::cerr << "canyon-rtcm-probe: " << r.error().to_string() << "\n";
       return kExitRuntime;

@@ -110,7 +110,9 @@ int run(int argc, char** argv) {
         ->required();
   }
   cli.add_option("--domain", domain, "DDS domain id")->check(CLI::Range(0, 232));
-  cli.add_option("--profiles", profiles, "Fast DDS XML profiles (default: the shipped config/dds/canyon_profiles.xml)");
+  cli.add_option("--profiles", profiles,
+                 "Deployment profiles (transport and discovery, deploy/dds/*.xml) on top of the shipped "
+                 "config/dds/canyon_profiles.xml");
   cli.add_option("--count", count, "Stop after this many samples (0: no limit)")->check(CLI::NonNegativeNumber);
   cli.add_option("--duration", duration_s, "Stop after this many seconds (0: no limit)")->check(CLI::NonNegativeNumber);
   cli.add_option("--until-gone", until_gone, "Stop once every matched publisher has left (true/false)");
@@ -133,7 +135,7 @@ int run(int argc, char** argv) {
                   kExitUsage);
     }
   }
-  if (auto s = pl::load_profiles_or_default(profiles); !s.ok()) return fail(s.error().to_string(), kExitUsage);
+  if (auto s = pl::load_profiles(profiles); !s.ok()) return fail(s.error().to_string(), kExitUsage);
 #ifdef CANYON_WITH_DASHBOARD
   std::unique_ptr<canyon::dashboard::DashboardServer> dashboard;
   if (http_port >= 0) {
@@ -148,7 +150,7 @@ int run(int argc, char** argv) {
               << (dashboard_options.web_dir.empty() ? " (page not built: /events and /metrics only)" : "") << std::endl;
   }
 #endif
-  auto participant = pl::DdsParticipant::create(domain);
+  auto participant = pl::DdsParticipant::create(domain, pl::load_profiles(profiles)->participant_profile());
   if (!participant) return fail(participant.error().to_string(), kExitRuntime);
 
   std::mutex mutex;  // the listeners of different readers may run on different threads
@@ -250,36 +252,37 @@ int run(int argc, char** argv) {
     }
   };
   if (g_tool == "monitor" || solutions) {
-    auto r = pl::SolutionReader::create(**participant, g_tool == "monitor" ? solution_topic : topic, "solution_reader",
-                                        on_solution);
+    auto r = pl::SolutionReader::create(**participant, g_tool == "monitor" ? solution_topic : topic,
+                                        canyon::dds::profile::kSolutionReader, on_solution);
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     solution_reader = std::move(*r);
   }
   if (g_tool == "monitor" || ends_with(topic, "timing")) {
-    auto r =
-        pl::TimingReader::create(**participant, g_tool == "monitor" ? timing_topic : topic, "timing_reader", on_timing);
+    auto r = pl::TimingReader::create(**participant, g_tool == "monitor" ? timing_topic : topic,
+                                      canyon::dds::profile::kTimingReader, on_timing);
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     timing_reader = std::move(*r);
   }
   if (g_tool != "monitor" && ends_with(topic, "rtcm")) {
-    auto r = pl::RtcmReader::create(**participant, topic, "rtcm_reader", [&](canyon::msg::RtcmFrame&& m) {
-      const std::lock_guard lock(mutex);
-      count_one();
-      auto f = pl::from_msg(m);
-      if (!f) {
-        ++bad;
-        if (error.empty()) error = f.error().to_string();
-        return;
-      }
-      if (g_tool == "echo") {
-        std::printf("rtcm #%llu message %u station %u %d %.3f %zu bytes\n",
-                    static_cast<unsigned long long>(m.sequence_number()), m.message_number(), m.station_id(),
-                    m.gps_week(), m.gps_tow_s(), f->bytes.size());
-        std::fflush(stdout);
-      } else {
-        raw.write(reinterpret_cast<const char*>(f->bytes.data()), static_cast<std::streamsize>(f->bytes.size()));
-      }
-    });
+    auto r = pl::RtcmReader::create(
+        **participant, topic, canyon::dds::profile::kRtcmReader, [&](canyon::msg::RtcmFrame&& m) {
+          const std::lock_guard lock(mutex);
+          count_one();
+          auto f = pl::from_msg(m);
+          if (!f) {
+            ++bad;
+            if (error.empty()) error = f.error().to_string();
+            return;
+          }
+          if (g_tool == "echo") {
+            std::printf("rtcm #%llu message %u station %u %d %.3f %zu bytes\n",
+                        static_cast<unsigned long long>(m.sequence_number()), m.message_number(), m.station_id(),
+                        m.gps_week(), m.gps_tow_s(), f->bytes.size());
+            std::fflush(stdout);
+          } else {
+            raw.write(reinterpret_cast<const char*>(f->bytes.data()), static_cast<std::streamsize>(f->bytes.size()));
+          }
+        });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     rtcm_reader = std::move(*r);
   }
@@ -295,25 +298,25 @@ int run(int argc, char** argv) {
     }
   };
   if (g_tool != "monitor" && ends_with(topic, "bridged")) {
-    auto r = pl::BridgedReader::create(**participant, topic, "stage_reader",
+    auto r = pl::BridgedReader::create(**participant, topic, canyon::dds::profile::kStageReader,
                                        [&](canyon::msg::BridgedEpoch&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     bridged_reader = std::move(*r);
   }
   if (g_tool != "monitor" && ends_with(topic, "prior")) {
-    auto r = pl::PriorReader::create(**participant, topic, "stage_reader",
+    auto r = pl::PriorReader::create(**participant, topic, canyon::dds::profile::kStageReader,
                                      [&](canyon::msg::Prior&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     prior_reader = std::move(*r);
   }
   if (g_tool != "monitor" && ends_with(topic, "float")) {
-    auto r = pl::FloatReader::create(**participant, topic, "stage_reader",
+    auto r = pl::FloatReader::create(**participant, topic, canyon::dds::profile::kStageReader,
                                      [&](canyon::msg::FloatSolution&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     float_reader = std::move(*r);
   }
   if (g_tool != "monitor" && ends_with(topic, "alignment")) {
-    auto r = pl::AlignmentReader::create(**participant, topic, "stage_reader",
+    auto r = pl::AlignmentReader::create(**participant, topic, canyon::dds::profile::kStageReader,
                                          [&](canyon::msg::Alignment&& m) { text_sample(pl::describe(m)); });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     alignment_reader = std::move(*r);
@@ -321,28 +324,30 @@ int run(int argc, char** argv) {
   std::unique_ptr<pl::VioPoseReader> vio_reader;
   std::unique_ptr<pl::TimeSyncReader> timesync_reader;
   if (g_tool != "monitor" && ends_with(topic, "vio")) {
-    auto r = pl::VioPoseReader::create(**participant, topic, "vio_reader", [&](canyon::msg::VioPose&& m) {
-      if (g_tool == "echo") return text_sample(pl::describe(m));
-      auto pose = pl::from_msg(m);
-      if (!pose) {
-        const std::lock_guard lock(mutex);
-        ++bad;
-        if (error.empty()) error = pose.error().to_string();
-        return;
-      }
-      text_sample(canyon::io::vio_csv_row(*pose));
-    });
+    auto r = pl::VioPoseReader::create(**participant, topic, canyon::dds::profile::kVioReader,
+                                       [&](canyon::msg::VioPose&& m) {
+                                         if (g_tool == "echo") return text_sample(pl::describe(m));
+                                         auto pose = pl::from_msg(m);
+                                         if (!pose) {
+                                           const std::lock_guard lock(mutex);
+                                           ++bad;
+                                           if (error.empty()) error = pose.error().to_string();
+                                           return;
+                                         }
+                                         text_sample(canyon::io::vio_csv_row(*pose));
+                                       });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     vio_reader = std::move(*r);
   }
   if (g_tool != "monitor" && ends_with(topic, "timesync")) {
-    auto r = pl::TimeSyncReader::create(**participant, topic, "vio_reader", [&](canyon::msg::TimeSyncSample&& m) {
-      if (g_tool == "echo") return text_sample(pl::describe(m));
-      char line[96];
-      std::snprintf(line, sizeof line, "%lld,%d,%.17g", static_cast<long long>(m.device_time_ns()), m.gps_week(),
-                    m.gps_tow_s());
-      text_sample(line);
-    });
+    auto r = pl::TimeSyncReader::create(
+        **participant, topic, canyon::dds::profile::kVioReader, [&](canyon::msg::TimeSyncSample&& m) {
+          if (g_tool == "echo") return text_sample(pl::describe(m));
+          char line[96];
+          std::snprintf(line, sizeof line, "%lld,%d,%.17g", static_cast<long long>(m.device_time_ns()), m.gps_week(),
+                        m.gps_tow_s());
+          text_sample(line);
+        });
     if (!r) return fail(r.error().to_string(), kExitRuntime);
     timesync_reader = std::move(*r);
   }

@@ -106,7 +106,9 @@ int run(int argc, char** argv) {
   cli.add_option("--pace", a.pace, "Replay speed: 1 real time, 10 ten times faster, 0 as fast as readers acknowledge")
       ->check(CLI::NonNegativeNumber);
   cli.add_option("--domain", a.domain, "DDS domain id")->check(CLI::Range(0, 232));
-  cli.add_option("--profiles", a.profiles, "Fast DDS XML profiles (default: config/dds/canyon_profiles.xml)");
+  cli.add_option("--profiles", a.profiles,
+                 "Deployment profiles (transport and discovery, deploy/dds/*.xml) on top of the shipped "
+                 "config/dds/canyon_profiles.xml");
   cli.add_option("--vio-topic", a.vio_topic, "Topic of the VioPose samples");
   cli.add_option("--timesync-topic", a.timesync_topic, "Topic of the TimeSyncSample samples");
   cli.add_option("--wait-for-readers", a.wait_readers, "Start once this many readers of each topic are matched")
@@ -144,24 +146,25 @@ int run(int argc, char** argv) {
     sync = std::move(*s);
   }
 
-  if (auto s = pl::load_profiles_or_default(a.profiles); !s.ok()) {
-    spdlog::error("{}", s.error().to_string());
+  const auto profiles = pl::load_profiles(a.profiles);
+  if (!profiles) {
+    spdlog::error("{}", profiles.error().to_string());
     return kExitUsage;
   }
-  auto participant = pl::DdsParticipant::create(a.domain);
+  auto participant = pl::DdsParticipant::create(a.domain, profiles->participant_profile());
   if (!participant) {
     spdlog::error("{}", participant.error().to_string());
     return kExitRuntime;
   }
   Writers w;
-  auto poses = pl::VioPoseWriter::create(**participant, a.vio_topic, "vio_writer");
+  auto poses = pl::VioPoseWriter::create(**participant, a.vio_topic, pl::profile::kVioWriter);
   if (!poses) {
     spdlog::error("{}", poses.error().to_string());
     return kExitRuntime;
   }
   w.poses = std::move(*poses);
   if (sync) {
-    auto pairs = pl::TimeSyncWriter::create(**participant, a.timesync_topic, "vio_writer");
+    auto pairs = pl::TimeSyncWriter::create(**participant, a.timesync_topic, pl::profile::kVioWriter);
     if (!pairs) {
       spdlog::error("{}", pairs.error().to_string());
       return kExitRuntime;
