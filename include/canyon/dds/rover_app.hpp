@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,10 @@ class RoverApp {
   [[nodiscard]] std::uint64_t epochs() const { return outputs_->epochs(); }
   [[nodiscard]] std::uint64_t solved() const { return outputs_->solved(); }
   [[nodiscard]] std::uint64_t fixed() const { return outputs_->fixed(); }
+  /// input.vio dds: what the live VIO received and used so far.
+  [[nodiscard]] std::optional<pipeline::LiveVioCounts> live_vio_counts() const {
+    return live_vio_ ? std::optional(live_vio_->counts()) : std::nullopt;
+  }
 
  private:
   /// An RTCM frame from the DDS listener to ingest.
