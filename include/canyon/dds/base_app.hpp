@@ -35,9 +35,8 @@ class BaseApp {
   /// Ends run() promptly (thread- and async-signal-safe).
   void stop() { base_->stop(); }
 
+  /// What the station has sent so far.
   [[nodiscard]] base::BaseStationStats stats() const { return base_->stats(); }
-  [[nodiscard]] int ntrip_port() const { return base_->ntrip_port(); }
-  [[nodiscard]] int tcp_port() const { return base_->tcp_port(); }
 
  private:
   void create_dds_output();

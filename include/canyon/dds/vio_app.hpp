@@ -41,9 +41,6 @@ class VioApp {
   /// Ends run() promptly (thread- and async-signal-safe).
   void stop() { stop_.store(true); }
 
-  /// Readers of the pose topic matched now.
-  [[nodiscard]] int matched() const { return poses_->matched(); }
-
  private:
   bool wait_for_readers() const;
   /// Publishes poses and pairs in device-time order; the number of samples the writers refused.
