@@ -95,7 +95,7 @@ class DdsApps : public ::testing::Test {
   static void TearDownTestSuite() { fs::remove_all(sim_); }
 
   fs::path work() {
-    const fs::path dir = sim_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::path dir = sim_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::create_directories(dir);
     return dir;
   }

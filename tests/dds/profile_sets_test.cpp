@@ -109,8 +109,8 @@ class ProfileSets : public ::testing::Test {
     (void)load_profiles("");  // the store as the other tests of this process expect it
   }
   fs::path temp_dir() {
-    const fs::path dir = fs::temp_directory_path() / ("canyon_profile_sets_" + std::to_string(::getpid()) + "_" +
-                                                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::path dir = fs::temp_directory_path() / ("canyon_profile_sets_" + std::to_string(::getpid()) + "_" +
+                                                ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir);
     fs::create_directories(dir);
     dirs_.push_back(dir);
