@@ -11,7 +11,9 @@
 #                         encrypted; topics canyon/* with read and write access control, submessages (metadata) and
 #                         data encrypted and authenticated (AES-GCM), so a tampered packet is rejected
 # OUT_DIR/ROLE/           cert.pem, key.pem, permissions.p7s, and lan.xml, wan-initial-peers.xml,
-#                         wan-discovery-server.xml: the deploy profiles with this role's security properties
+#                         wan-discovery-server.xml: the deployment files with this role's security properties in
+#                         their participant profile canyon_deployment (transport, discovery and security only:
+#                         like the plain ones they are loaded on top of config/dds/canyon_profiles.xml)
 # Roles and permissions (topic names are fnmatch patterns; default DENY):
 #   base     publish canyon/rtcm
 #   rover    subscribe canyon/rtcm; publish canyon/* except canyon/rtcm (solutions, stage outputs, timing)

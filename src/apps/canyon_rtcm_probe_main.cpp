@@ -102,7 +102,7 @@ double json_number(const std::string& text, const std::string& key) {
 }
 
 int inject(canyon::dds::DdsParticipant& participant, const std::string& topic, int count, double wait_s) {
-  auto writer = canyon::dds::RtcmWriter::create(participant, topic, "rtcm_writer");
+  auto writer = canyon::dds::RtcmWriter::create(participant, topic, canyon::dds::profile::kRtcmWriter);
   if (!writer) {
     std::cout << "{\"writer\":false,\"error\":\"" << writer.error().message << "\"}\n";
     return kExitRefused;
@@ -132,8 +132,7 @@ int inject(canyon::dds::DdsParticipant& participant, const std::string& topic, i
   return 0;
 }
 
-int run(int argc, char** argv) {
-  CLI::App cli{"canyon-rtcm-probe: measure (or, for security tests, inject) RtcmFrame samples"};
+struct Args {
   std::string mode = "subscribe";
   std::string profiles;
   std::string topic = "canyon/rtcm";
@@ -147,161 +146,73 @@ int run(int argc, char** argv) {
   double duration_s = 600.0;
   double idle_s = 5.0;
   double wait_s = 20.0;
-  cli.add_option("--mode", mode, "subscribe or inject")->check(CLI::IsMember({"subscribe", "inject"}));
-  cli.add_option("--profiles", profiles, "Fast DDS XML profiles (default config/dds/canyon_profiles.xml)")
-      ->check(CLI::ExistingFile);
-  cli.add_option("--domain", domain, "DDS domain")->check(CLI::Range(0, 232));
-  cli.add_option("--topic", topic, "topic of RtcmFrame samples");
-  cli.add_option("--readers", readers, "subscribe: participants, one reader each")->check(CLI::Range(1, 256));
-  cli.add_option("--station", station, "subscribe: the expected station id; frames of others count as foreign");
-  cli.add_option("--duration", duration_s, "stop after this many seconds")->check(CLI::PositiveNumber);
-  cli.add_option("--idle", idle_s, "subscribe: stop this many seconds after the last frame")
-      ->check(CLI::PositiveNumber);
-  cli.add_option("--wait", wait_s, "inject: wait this long for a matched reader")->check(CLI::NonNegativeNumber);
-  cli.add_option("--count", count, "inject: frames to publish")->check(CLI::Range(1, 100000));
-  cli.add_option("--json-lines", json_lines, "subscribe: dashboard snapshot every second to this file ('-' stdout)");
-  cli.add_option("--arrivals", arrivals, "subscribe: CSV of every frame of reader 0 (monotonic arrival, seq, times)");
-  cli.add_option("--link-stats", link_stats, "canyon-linkemu --stats file whose counters go into the snapshots");
-  try {
-    cli.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = cli.exit(e);
-    return code == 0 ? 0 : kExitUsage;
-  }
-  if (auto s = canyon::dds::load_profiles_or_default(profiles); !s.ok()) {
-    std::cerr << "canyon-rtcm-probe: " << s.error().to_string() << "\n";
-    return kExitUsage;
-  }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+};
 
-  if (mode == "inject") {
-    auto p = canyon::dds::DdsParticipant::create(domain);
-    if (!p) {
-      std::cout << "{\"participant\":false,\"error\":\"" << p.error().message << "\"}\n";
-      return kExitRefused;
-    }
-    return inject(**p, topic, count, wait_s);
+/// Counts one frame of reader `k` (under the caller's lock); reader 0 also writes its arrival to `arrivals`.
+void count_frame(ReaderStats& s, std::size_t k, const canyon::msg::RtcmFrame& m,
+                 const canyon::Result<canyon::base::BaseFrame>& f, int station, std::int64_t now,
+                 std::ostream* arrivals) {
+  if (!f) {
+    ++s.bad;
+    return;
   }
+  if (station >= 0 && f->station_id != station) {
+    ++s.foreign;
+    return;
+  }
+  ++s.received;
+  const auto seq = static_cast<std::int64_t>(f->sequence);
+  if (seq == 0 && s.last_seq > 0) {  // a new base run numbers its frames from 0 again
+    ++s.restarts;
+    s.seen.clear();
+    s.last_seq = -1;
+  }
+  if (k == 0 && arrivals != nullptr) {
+    *arrivals << canyon::core::pipeline_now_ns() << "," << seq << "," << m.send_unix_ns() << "," << now << "\n";
+  }
+  if (!s.seen.insert(f->sequence).second) {
+    ++s.duplicates;
+    return;
+  }
+  if (s.first_seq < 0) s.first_seq = seq;
+  if (seq < s.last_seq) {
+    ++s.out_of_order;
+  } else {
+    if (s.last_seq >= 0 && seq > s.last_seq + 1) s.gaps += static_cast<std::uint64_t>(seq - s.last_seq - 1);
+    s.last_seq = seq;
+  }
+  s.newest_send_unix_ns = std::max(s.newest_send_unix_ns, m.send_unix_ns());
+  s.latency_ms.push_back(static_cast<double>(now - m.send_unix_ns()) * 1e-6);
+}
 
-  std::ofstream arrivals_file;
-  std::ofstream* arrivals_out = nullptr;
-  if (!arrivals.empty()) {
-    arrivals_file.open(arrivals, std::ios::trunc);
-    if (!arrivals_file) {
-      std::cerr << "canyon-rtcm-probe: cannot write " << arrivals << "\n";
-      return kExitUsage;
-    }
-    arrivals_file << "recv_monotonic_ns,seq,send_unix_ns,recv_unix_ns\n";
-    arrivals_out = &arrivals_file;
+/// The dashboard snapshot of reader 0 (one JSON line).
+std::string snapshot_line(const ReaderStats& s, std::int64_t start_ns, std::int64_t now,
+                          const std::string& link_stats) {
+  std::vector<double> recent(
+      s.latency_ms.end() - std::min<std::ptrdiff_t>(200, static_cast<std::ptrdiff_t>(s.latency_ms.size())),
+      s.latency_ms.end());
+  std::ostringstream line;
+  line.precision(6);
+  line << "{\"t_s\":" << static_cast<double>(now - start_ns) * 1e-9;
+  line << ",\"stages\":{\"dds_transport\":{\"p50_us\":" << percentile(recent, 50) * 1e3
+       << ",\"p95_us\":" << percentile(recent, 95) * 1e3 << ",\"p99_us\":" << percentile(recent, 99) * 1e3
+       << ",\"max_us\":" << (recent.empty() ? 0.0 : *std::max_element(recent.begin(), recent.end())) * 1e3
+       << ",\"count\":" << s.latency_ms.size() << "}}";
+  line << ",\"correction_age_s\":"
+       << (s.newest_send_unix_ns > 0 ? static_cast<double>(unix_now_ns() - s.newest_send_unix_ns) * 1e-9 : -1.0);
+  line << ",\"queues\":{},\"drops\":{\"rtcm_gap\":" << s.gaps << ",\"rtcm_bad\":" << s.bad;
+  if (!link_stats.empty()) {
+    const std::string link = read_file(link_stats);
+    line << ",\"link_lost\":"
+         << json_number(link, "lost") + json_number(link, "outage_drops") + json_number(link, "queue_drops")
+         << ",\"link_packets\":" << json_number(link, "packets");
   }
-  std::mutex mutex;
-  std::vector<ReaderStats> stats(static_cast<std::size_t>(readers));
-  std::atomic<std::int64_t> last_frame_ns{0};
-  std::vector<std::unique_ptr<canyon::dds::DdsParticipant>> participants;
-  std::vector<std::unique_ptr<canyon::dds::RtcmReader>> dds_readers;
-  for (int k = 0; k < readers; ++k) {
-    auto p = canyon::dds::DdsParticipant::create(domain);
-    if (!p) {
-      std::cerr << "canyon-rtcm-probe: " << p.error().to_string() << "\n";
-      return kExitRuntime;
-    }
-    auto r = canyon::dds::RtcmReader::create(**p, topic, "rtcm_reader", [&, k](canyon::msg::RtcmFrame&& m) {
-      const std::int64_t now = unix_now_ns();
-      last_frame_ns.store(canyon::core::pipeline_now_ns());
-      auto f = canyon::dds::from_msg(m);
-      const std::lock_guard lock(mutex);
-      ReaderStats& s = stats[static_cast<std::size_t>(k)];
-      if (!f) {
-        ++s.bad;
-        return;
-      }
-      if (station >= 0 && f->station_id != station) {
-        ++s.foreign;
-        return;
-      }
-      ++s.received;
-      const auto seq = static_cast<std::int64_t>(f->sequence);
-      if (seq == 0 && s.last_seq > 0) {  // a new base run numbers its frames from 0 again
-        ++s.restarts;
-        s.seen.clear();
-        s.last_seq = -1;
-      }
-      if (k == 0 && arrivals_out != nullptr) {
-        *arrivals_out << canyon::core::pipeline_now_ns() << "," << seq << "," << m.send_unix_ns() << "," << now << "\n";
-      }
-      if (!s.seen.insert(f->sequence).second) {
-        ++s.duplicates;
-        return;
-      }
-      if (s.first_seq < 0) s.first_seq = seq;
-      if (seq < s.last_seq) {
-        ++s.out_of_order;
-      } else {
-        if (s.last_seq >= 0 && seq > s.last_seq + 1) s.gaps += static_cast<std::uint64_t>(seq - s.last_seq - 1);
-        s.last_seq = seq;
-      }
-      s.newest_send_unix_ns = std::max(s.newest_send_unix_ns, m.send_unix_ns());
-      s.latency_ms.push_back(static_cast<double>(now - m.send_unix_ns()) * 1e-6);
-    });
-    if (!r) {
-      std::cerr << "canyon-rtcm-probe: " << r.error().to_string() << "\n";
-      return kExitRuntime;
-    }
-    participants.push_back(std::move(*p));
-    dds_readers.push_back(std::move(*r));
-  }
-  std::ofstream snapshot_file;
-  std::ostream* snapshots = nullptr;
-  if (json_lines == "-") {
-    snapshots = &std::cout;
-  } else if (!json_lines.empty()) {
-    snapshot_file.open(json_lines, std::ios::trunc);
-    if (!snapshot_file) {
-      std::cerr << "canyon-rtcm-probe: cannot write " << json_lines << "\n";
-      return kExitUsage;
-    }
-    snapshots = &snapshot_file;
-  }
+  line << "}}\n";
+  return line.str();
+}
 
-  const std::int64_t start_ns = canyon::core::pipeline_now_ns();
-  std::int64_t next_snapshot_ns = start_ns + 1'000'000'000;
-  while (!g_stop.load()) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    const std::int64_t now = canyon::core::pipeline_now_ns();
-    if (static_cast<double>(now - start_ns) * 1e-9 > duration_s) break;
-    const std::int64_t last = last_frame_ns.load();
-    if (last > 0 && static_cast<double>(now - last) * 1e-9 > idle_s) break;
-    if (snapshots != nullptr && now >= next_snapshot_ns) {
-      next_snapshot_ns += 1'000'000'000;
-      const std::lock_guard lock(mutex);
-      const ReaderStats& s = stats[0];
-      std::vector<double> recent(
-          s.latency_ms.end() - std::min<std::ptrdiff_t>(200, static_cast<std::ptrdiff_t>(s.latency_ms.size())),
-          s.latency_ms.end());
-      std::ostringstream line;
-      line.precision(6);
-      line << "{\"t_s\":" << static_cast<double>(now - start_ns) * 1e-9;
-      line << ",\"stages\":{\"dds_transport\":{\"p50_us\":" << percentile(recent, 50) * 1e3
-           << ",\"p95_us\":" << percentile(recent, 95) * 1e3 << ",\"p99_us\":" << percentile(recent, 99) * 1e3
-           << ",\"max_us\":" << (recent.empty() ? 0.0 : *std::max_element(recent.begin(), recent.end())) * 1e3
-           << ",\"count\":" << s.latency_ms.size() << "}}";
-      line << ",\"correction_age_s\":"
-           << (s.newest_send_unix_ns > 0 ? static_cast<double>(unix_now_ns() - s.newest_send_unix_ns) * 1e-9 : -1.0);
-      line << ",\"queues\":{},\"drops\":{\"rtcm_gap\":" << s.gaps << ",\"rtcm_bad\":" << s.bad;
-      if (!link_stats.empty()) {
-        const std::string link = read_file(link_stats);
-        line << ",\"link_lost\":"
-             << json_number(link, "lost") + json_number(link, "outage_drops") + json_number(link, "queue_drops")
-             << ",\"link_packets\":" << json_number(link, "packets");
-      }
-      line << "}}\n";
-      *snapshots << line.str() << std::flush;
-    }
-  }
-  dds_readers.clear();
-  participants.clear();
-
+/// Prints the summary of every reader (one JSON object); kExitNothing if no frame arrived.
+int summarise(const std::vector<ReaderStats>& stats, const Args& a) {
   std::vector<double> all;
   std::ostringstream out;
   out << "{\"readers\":[";
@@ -330,11 +241,130 @@ int run(int argc, char** argv) {
       << ",\"latency\":" << latency_json(all) << "}\n";
   std::cout << out.str();
   if (all.empty()) {
-    std::cerr << "canyon-rtcm-probe: no frame received on '" << topic << "' (domain " << domain
+    std::cerr << "canyon-rtcm-probe: no frame received on '" << a.topic << "' (domain " << a.domain
               << "): no base matched (link down, wrong domain, profile or topic, or refused by DDS-Security)\n";
     return kExitNothing;
   }
   return 0;
+}
+
+/// Opens `path` for writing into `file` ("-": stdout); `out` null if `path` is empty; false if it cannot be written.
+bool open_output(const std::string& path, std::ofstream& file, std::ostream*& out) {
+  out = nullptr;
+  if (path == "-") {
+    out = &std::cout;
+  } else if (!path.empty()) {
+    file.open(path, std::ios::trunc);
+    if (!file) return false;
+    out = &file;
+  }
+  return true;
+}
+
+int subscribe(const Args& a, const canyon::dds::ProfileSet& profiles) {
+  std::ofstream arrivals_file;
+  std::ostream* arrivals_out = nullptr;
+  if (!a.arrivals.empty()) {
+    arrivals_file.open(a.arrivals, std::ios::trunc);
+    if (!arrivals_file) {
+      std::cerr << "canyon-rtcm-probe: cannot write " << a.arrivals << "\n";
+      return kExitUsage;
+    }
+    arrivals_file << "recv_monotonic_ns,seq,send_unix_ns,recv_unix_ns\n";
+    arrivals_out = &arrivals_file;
+  }
+  std::mutex mutex;
+  std::vector<ReaderStats> stats(static_cast<std::size_t>(a.readers));
+  std::atomic<std::int64_t> last_frame_ns{0};
+  std::vector<std::unique_ptr<canyon::dds::DdsParticipant>> participants;
+  std::vector<std::unique_ptr<canyon::dds::RtcmReader>> dds_readers;
+  for (std::size_t k = 0; k < stats.size(); ++k) {
+    auto p = canyon::dds::DdsParticipant::create(a.domain, profiles.participant_profile());
+    if (!p) {
+      std::cerr << "canyon-rtcm-probe: " << p.error().to_string() << "\n";
+      return kExitRuntime;
+    }
+    auto r = canyon::dds::RtcmReader::create(**p, a.topic, canyon::dds::profile::kRtcmReader,
+                                             [&, k](canyon::msg::RtcmFrame&& m) {
+                                               const std::int64_t now = unix_now_ns();
+                                               last_frame_ns.store(canyon::core::pipeline_now_ns());
+                                               const auto f = canyon::dds::from_msg(m);
+                                               const std::lock_guard lock(mutex);
+                                               count_frame(stats[k], k, m, f, a.station, now, arrivals_out);
+                                             });
+    if (!r) {
+      std::cerr << "canyon-rtcm-probe: " << r.error().to_string() << "\n";
+      return kExitRuntime;
+    }
+    participants.push_back(std::move(*p));
+    dds_readers.push_back(std::move(*r));
+  }
+  std::ofstream snapshot_file;
+  std::ostream* snapshots = nullptr;
+  if (!open_output(a.json_lines, snapshot_file, snapshots)) {
+    std::cerr << "canyon-rtcm-probe: cannot write " << a.json_lines << "\n";
+    return kExitUsage;
+  }
+  const std::int64_t start_ns = canyon::core::pipeline_now_ns();
+  std::int64_t next_snapshot_ns = start_ns + 1'000'000'000;
+  while (!g_stop.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const std::int64_t now = canyon::core::pipeline_now_ns();
+    if (static_cast<double>(now - start_ns) * 1e-9 > a.duration_s) break;
+    const std::int64_t last = last_frame_ns.load();
+    if (last > 0 && static_cast<double>(now - last) * 1e-9 > a.idle_s) break;
+    if (snapshots != nullptr && now >= next_snapshot_ns) {
+      next_snapshot_ns += 1'000'000'000;
+      const std::lock_guard lock(mutex);
+      *snapshots << snapshot_line(stats[0], start_ns, now, a.link_stats) << std::flush;
+    }
+  }
+  dds_readers.clear();
+  participants.clear();
+  return summarise(stats, a);
+}
+
+int run(int argc, char** argv) {
+  CLI::App cli{"canyon-rtcm-probe: measure (or, for security tests, inject) RtcmFrame samples"};
+  Args a;
+  cli.add_option("--mode", a.mode, "subscribe or inject")->check(CLI::IsMember({"subscribe", "inject"}));
+  cli.add_option("--profiles", a.profiles,
+                 "Deployment profiles (transport and discovery) on top of the shipped config/dds/canyon_profiles.xml")
+      ->check(CLI::ExistingFile);
+  cli.add_option("--domain", a.domain, "DDS domain")->check(CLI::Range(0, 232));
+  cli.add_option("--topic", a.topic, "topic of RtcmFrame samples");
+  cli.add_option("--readers", a.readers, "subscribe: participants, one reader each")->check(CLI::Range(1, 256));
+  cli.add_option("--station", a.station, "subscribe: the expected station id; frames of others count as foreign");
+  cli.add_option("--duration", a.duration_s, "stop after this many seconds")->check(CLI::PositiveNumber);
+  cli.add_option("--idle", a.idle_s, "subscribe: stop this many seconds after the last frame")
+      ->check(CLI::PositiveNumber);
+  cli.add_option("--wait", a.wait_s, "inject: wait this long for a matched reader")->check(CLI::NonNegativeNumber);
+  cli.add_option("--count", a.count, "inject: frames to publish")->check(CLI::Range(1, 100000));
+  cli.add_option("--json-lines", a.json_lines, "subscribe: dashboard snapshot every second to this file ('-' stdout)");
+  cli.add_option("--arrivals", a.arrivals, "subscribe: CSV of every frame of reader 0 (monotonic arrival, seq, times)");
+  cli.add_option("--link-stats", a.link_stats, "canyon-linkemu --stats file whose counters go into the snapshots");
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = cli.exit(e);
+    return code == 0 ? 0 : kExitUsage;
+  }
+  const auto loaded = canyon::dds::load_profiles(a.profiles);
+  if (!loaded) {
+    std::cerr << "canyon-rtcm-probe: " << loaded.error().to_string() << "\n";
+    return kExitUsage;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  if (a.mode == "inject") {
+    auto p = canyon::dds::DdsParticipant::create(a.domain, loaded->participant_profile());
+    if (!p) {
+      std::cout << "{\"participant\":false,\"error\":\"" << p.error().message << "\"}\n";
+      return kExitRefused;
+    }
+    return inject(**p, a.topic, a.count, a.wait_s);
+  }
+  return subscribe(a, *loaded);
 }
 
 }  // namespace

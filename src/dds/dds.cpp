@@ -2,10 +2,6 @@
 
 #include "canyon/dds/dds.hpp"
 
-#include <set>
-
-#include "canyon/config/shipped_config.hpp"
-
 namespace canyon::dds {
 namespace {
 
@@ -19,30 +15,6 @@ std::uint64_t malformed_payloads() {
 
 void detail::count_malformed_payload() {
   g_malformed_payloads.fetch_add(1);
-}
-
-Result<std::string> default_profiles_file() {
-  return config::find_shipped_config("dds/canyon_profiles.xml");
-}
-
-Status load_profiles(const std::string& path) {
-  static std::mutex mutex;
-  static std::set<std::string> loaded;
-  const std::lock_guard lock(mutex);
-  if (loaded.count(path) != 0) return Ok{};
-  const auto rc = fdds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(path);
-  if (rc != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
-    return Error{"cannot load the Fast DDS XML profiles (missing file or invalid XML)", path, 0};
-  }
-  loaded.insert(path);
-  return Ok{};
-}
-
-Status load_profiles_or_default(const std::string& path) {
-  if (!path.empty()) return load_profiles(path);
-  auto found = default_profiles_file();
-  if (!found) return found.error();
-  return load_profiles(*found);
 }
 
 Result<std::unique_ptr<DdsParticipant>> DdsParticipant::create(int domain, const std::string& profile) {

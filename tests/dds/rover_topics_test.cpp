@@ -141,10 +141,9 @@ TEST(RoverMsgs, VioPoseAndTimeSyncRoundTripBitForBitAndRefuseMalformed) {
 class RoverTopics : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto profiles = default_profiles_file();
+    auto profiles = load_profiles("");
     ASSERT_TRUE(profiles.ok()) << profiles.error().to_string();
-    ASSERT_TRUE(load_profiles(*profiles).ok());
-    auto p = DdsParticipant::create(test_domain());
+    auto p = DdsParticipant::create(test_domain(), profile::kParticipant);
     ASSERT_TRUE(p.ok()) << p.error().to_string();
     participant_ = std::move(*p);
     topic_ = "canyon/solution/test" + std::to_string(::getpid()) + "/" +
@@ -155,7 +154,7 @@ class RoverTopics : public ::testing::Test {
 };
 
 TEST_F(RoverTopics, LateSubscriberGetsEverySolutionFromItsFirstOn) {
-  auto writer = SolutionWriter::create(*participant_, topic_, "solution_writer");
+  auto writer = SolutionWriter::create(*participant_, topic_, profile::kSolutionWriter);
   ASSERT_TRUE(writer.ok()) << writer.error().to_string();
   EpochContext context;
   std::uint64_t seq = 0;
@@ -168,7 +167,7 @@ TEST_F(RoverTopics, LateSubscriberGetsEverySolutionFromItsFirstOn) {
   publish(20);  // nobody listens yet
   std::mutex mutex;
   std::vector<std::uint64_t> got;
-  auto reader = SolutionReader::create(*participant_, topic_, "solution_reader", [&](msg::Solution&& m) {
+  auto reader = SolutionReader::create(*participant_, topic_, profile::kSolutionReader, [&](msg::Solution&& m) {
     const std::lock_guard lock(mutex);
     got.push_back(m.sequence_number());
   });
@@ -191,7 +190,7 @@ TEST_F(RoverTopics, LateSubscriberGetsEverySolutionFromItsFirstOn) {
 TEST_F(RoverTopics, RestartedPublisherIsMatchedAgain) {
   std::mutex mutex;
   std::vector<std::uint64_t> got;
-  auto reader = SolutionReader::create(*participant_, topic_, "solution_reader", [&](msg::Solution&& m) {
+  auto reader = SolutionReader::create(*participant_, topic_, profile::kSolutionReader, [&](msg::Solution&& m) {
     const std::lock_guard lock(mutex);
     got.push_back(m.sequence_number());
   });
@@ -199,9 +198,9 @@ TEST_F(RoverTopics, RestartedPublisherIsMatchedAgain) {
   EpochContext context;
   for (int run = 0; run < 2; ++run) {
     // A separate participant per run, as a rover process that exits and starts again.
-    auto p = DdsParticipant::create(test_domain());
+    auto p = DdsParticipant::create(test_domain(), profile::kParticipant);
     ASSERT_TRUE(p.ok());
-    auto writer = SolutionWriter::create(**p, topic_, "solution_writer");
+    auto writer = SolutionWriter::create(**p, topic_, profile::kSolutionWriter);
     ASSERT_TRUE(writer.ok());
     wait_for([&] { return (*writer)->matched() == 1; });
     ASSERT_EQ((*writer)->matched(), 1) << "run " << run;

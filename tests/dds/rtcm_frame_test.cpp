@@ -106,10 +106,9 @@ TEST(RtcmFrameDds, EverySubscriberReceivesEveryFrameOfCanyonBase) {
                         << "  ntrip: {enabled: false}\n"
                         << "log: {progress_interval_s: 0}\n";
 
-  auto profiles = default_profiles_file();
+  auto profiles = load_profiles("");
   ASSERT_TRUE(profiles.ok()) << profiles.error().to_string();
-  ASSERT_TRUE(load_profiles(*profiles).ok());
-  auto participant = DdsParticipant::create(domain);
+  auto participant = DdsParticipant::create(domain, profile::kParticipant);
   ASSERT_TRUE(participant.ok()) << participant.error().to_string();
   constexpr int kReaders = 3;
   std::mutex mutex;
@@ -117,7 +116,7 @@ TEST(RtcmFrameDds, EverySubscriberReceivesEveryFrameOfCanyonBase) {
   std::vector<int> bad(kReaders, 0);
   std::vector<std::unique_ptr<RtcmReader>> readers;
   for (int k = 0; k < kReaders; ++k) {
-    auto reader = RtcmReader::create(**participant, topic, "rtcm_reader", [&, k](msg::RtcmFrame&& m) {
+    auto reader = RtcmReader::create(**participant, topic, profile::kRtcmReader, [&, k](msg::RtcmFrame&& m) {
       auto f = from_msg(m);
       const std::lock_guard lock(mutex);
       if (f) {

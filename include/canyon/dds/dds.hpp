@@ -1,7 +1,8 @@
 #pragma once
-// A small Fast DDS 2.9 shell: XML QoS profiles loaded once before any participant, a participant that owns its
-// topics, and typed writers and readers created from named profiles (config/dds/canyon_profiles.xml). Entities
-// are deleted in reverse order by the destructors. Readers hand samples to a callback on Fast DDS's listener
+// A small Fast DDS 2.9 shell: XML QoS profiles loaded once before any participant (profiles.hpp: the shipped QoS
+// file, and a deployment file's transport and discovery on top), a participant that owns its topics, and typed
+// writers and readers created from named profiles (the profile:: constants). Entities are deleted in reverse order
+// by the destructors. Readers hand samples to a callback on Fast DDS's listener
 // thread: the callback should only queue them.
 //
 // QoS comes from the XML profiles only (TOOLCHAIN.md: a profile applies when it is loaded before the participant is
@@ -30,22 +31,16 @@
 #include <fastdds/rtps/common/SerializedPayload.h>
 
 #include "canyon/core/result.hpp"
+#include "canyon/dds/profiles.hpp"
 
 namespace canyon::dds {
 
 namespace fdds = eprosima::fastdds::dds;
 
-/// The shipped profiles file (config/dds/canyon_profiles.xml next to the executable or in the source tree).
-Result<std::string> default_profiles_file();
-/// Loads Fast DDS XML profiles; call before creating participants. Loading the same file again is a no-op.
-Status load_profiles(const std::string& path);
-/// load_profiles(path), or the shipped file (default_profiles_file()) when `path` is empty.
-Status load_profiles_or_default(const std::string& path);
-
 class DdsParticipant {
  public:
-  /// A participant on `domain` from the participant profile `profile`.
-  static Result<std::unique_ptr<DdsParticipant>> create(int domain, const std::string& profile = "canyon_participant");
+  /// A participant on `domain` from the participant profile `profile` (ProfileSet::participant_profile()).
+  static Result<std::unique_ptr<DdsParticipant>> create(int domain, const std::string& profile);
   ~DdsParticipant();
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;

@@ -1,0 +1,91 @@
+#pragma once
+// The rover's per-epoch outputs: the one place where canyon rover meets the pipeline's stage messages
+// (pipeline::EpochItem, pipeline::StageObserver, pipeline::EpochSink) besides the conversions of rover_msgs.hpp.
+//   - sink(): the epoch's solution to the .pos (estimator.out) and, for an NTRIP base, as the GGA the link uploads;
+//     the epoch counts;
+//   - observer(): the solution is published the moment the ambiguity stage has it. The stage outputs (canyon/bridged,
+//     /prior, /float, /alignment: every stage's output is still in the epoch then) and the timing are taken then too
+//     and written once the epoch has moved on (StageObserver::handed_on): their DDS writes delay no epoch and, in the
+//     threaded pipeline, no other stage's thread (on two cores a write on the time bridge's thread held up the next
+//     stage's wake-up). The pending messages belong to the ambiguity stage's thread.
+// It owns the rover's writers (the solution and timing topics; with dds.publish_stages the stage outputs).
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "canyon/config/rover_config.hpp"
+#include "canyon/dds/dds.hpp"
+#include "canyon/dds/rover_msgs.hpp"
+#include "canyon/io/pos_file.hpp"
+#include "canyon/pipeline/byte_link.hpp"
+#include "canyon/pipeline/epoch_pipeline.hpp"
+#include "canyon/pipeline/live_vio.hpp"
+#include "canyon/pipeline/rover_ingest.hpp"
+
+namespace canyon::dds {
+
+class RoverOutputs {
+ public:
+  /// The solution and timing writers, and with dds.publish_stages the stage writers (canyon/bridged and
+  /// canyon/alignment in fusion mode only); AppError if one cannot be created.
+  RoverOutputs(DdsParticipant& participant, const config::RoverConfig& config);
+  ~RoverOutputs();
+  RoverOutputs(const RoverOutputs&) = delete;
+  RoverOutputs& operator=(const RoverOutputs&) = delete;
+
+  /// The .pos the sink writes (estimator.out).
+  void set_pos(io::PosWriter pos) { pos_.emplace(std::move(pos)); }
+  /// The link that uploads the rover's latest solution as GGA (input.ntrip_gga_interval_s > 0).
+  void set_gga_link(std::shared_ptr<pipeline::ByteLink> link) { gga_link_ = std::move(link); }
+  /// What the messages carry besides the epoch: late base epochs, the live VIO's counts (may be null), the queues.
+  void set_sources(const pipeline::RoverIngest& source, const pipeline::LiveVio* live_vio,
+                   const pipeline::EpochPipeline& pipeline);
+
+  [[nodiscard]] pipeline::EpochSink sink();
+  [[nodiscard]] pipeline::StageObserver observer();
+
+  /// Closes the .pos, if any (a write error that happened on the way).
+  Status close_pos();
+  /// Readers of the solution topic matched now.
+  [[nodiscard]] int solution_readers() const { return solution_->matched(); }
+  /// Waits until the solution and timing readers acknowledged every sample, at most timeout_s each.
+  bool wait_for_acknowledgments(double timeout_s);
+  /// Samples the writers refused (history full).
+  [[nodiscard]] std::uint64_t refused() const { return refused_.load(); }
+  [[nodiscard]] std::uint64_t epochs() const { return epochs_; }
+  [[nodiscard]] std::uint64_t solved() const { return solved_; }
+  [[nodiscard]] std::uint64_t fixed() const { return fixed_; }
+
+ private:
+  Status write_epoch(const pipeline::EpochItem& item);
+  void taken(pipeline::Stage stage, const pipeline::EpochItem& item);
+  void handed_on(pipeline::Stage stage);
+  void update_context(const pipeline::EpochItem& item);
+
+  std::string rover_id_;
+  std::unique_ptr<SolutionWriter> solution_;
+  std::unique_ptr<TimingWriter> timing_;
+  std::unique_ptr<BridgedWriter> bridged_;
+  std::unique_ptr<AlignmentWriter> alignment_;
+  std::unique_ptr<PriorWriter> prior_;
+  std::unique_ptr<FloatWriter> float_;
+  std::optional<io::PosWriter> pos_;
+  std::shared_ptr<pipeline::ByteLink> gga_link_;
+  const pipeline::RoverIngest* source_ = nullptr;
+  const pipeline::LiveVio* live_vio_ = nullptr;
+  const pipeline::EpochPipeline* pipeline_ = nullptr;
+  // The sink's thread.
+  std::uint64_t epochs_ = 0, solved_ = 0, fixed_ = 0;
+  // The ambiguity stage's thread.
+  EpochContext context_;
+  std::optional<msg::BridgedEpoch> bridged_pending_;
+  std::optional<msg::Prior> prior_pending_;
+  std::optional<msg::FloatSolution> float_pending_;
+  std::optional<msg::Alignment> alignment_pending_;
+  std::optional<msg::StageTiming> timing_pending_;
+  std::atomic<std::uint64_t> refused_{0};  // the time bridge's and the ambiguity stage's threads publish
+};
+
+}  // namespace canyon::dds

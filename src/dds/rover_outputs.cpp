@@ -1,0 +1,126 @@
+// The rover's per-epoch outputs (see rover_outputs.hpp).
+
+#include "canyon/dds/rover_outputs.hpp"
+
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "canyon/dds/app.hpp"
+#include "canyon/io/nmea.hpp"
+
+namespace canyon::dds {
+namespace {
+
+template <typename Writer>
+std::unique_ptr<Writer> create_writer(DdsParticipant& participant, const std::string& topic, const char* profile) {
+  return value_or_throw(Writer::create(participant, topic, profile), kExitRuntime);
+}
+
+/// Writes the pending message, if any, and forgets it; counts a refusal.
+template <typename Writer, typename Msg>
+void write_pending(Writer& writer, std::optional<Msg>& pending, std::atomic<std::uint64_t>& refused) {
+  if (writer && pending && !writer->write(*pending)) refused.fetch_add(1);
+  pending.reset();
+}
+
+}  // namespace
+
+RoverOutputs::RoverOutputs(DdsParticipant& participant, const config::RoverConfig& config)
+    : rover_id_(config.rover_id) {
+  solution_ = create_writer<SolutionWriter>(participant, config.solution_topic, profile::kSolutionWriter);
+  timing_ = create_writer<TimingWriter>(participant, config.timing_topic, profile::kTimingWriter);
+  if (!config.publish_stages) return;
+  prior_ = create_writer<PriorWriter>(participant, "canyon/prior", profile::kStageWriter);
+  float_ = create_writer<FloatWriter>(participant, "canyon/float", profile::kStageWriter);
+  if (config.estimator.mode == config::ProcessMode::Fusion) {
+    bridged_ = create_writer<BridgedWriter>(participant, "canyon/bridged", profile::kStageWriter);
+    alignment_ = create_writer<AlignmentWriter>(participant, "canyon/alignment", profile::kStageWriter);
+  }
+}
+
+RoverOutputs::~RoverOutputs() = default;
+
+void RoverOutputs::set_sources(const pipeline::RoverIngest& source, const pipeline::LiveVio* live_vio,
+                               const pipeline::EpochPipeline& pipeline) {
+  source_ = &source;
+  live_vio_ = live_vio;
+  pipeline_ = &pipeline;
+}
+
+pipeline::EpochSink RoverOutputs::sink() {
+  return [this](const pipeline::EpochItem& item) { return write_epoch(item); };
+}
+
+pipeline::StageObserver RoverOutputs::observer() {
+  pipeline::StageObserver observer;
+  observer.taken = [this](pipeline::Stage stage, const pipeline::EpochItem& item) { taken(stage, item); };
+  observer.handed_on = [this](pipeline::Stage stage) { handed_on(stage); };
+  return observer;
+}
+
+Status RoverOutputs::write_epoch(const pipeline::EpochItem& item) {
+  ++epochs_;
+  if (item.output) {
+    ++solved_;
+    if (item.output->solution.status == core::SolutionStatus::Fixed) ++fixed_;
+    if (gga_link_) gga_link_->set_gga(io::format_gga(item.output->solution));  // uploaded at the link's interval
+    if (pos_) return pos_->write(item.output->solution);
+  }
+  return Ok{};
+}
+
+void RoverOutputs::update_context(const pipeline::EpochItem& item) {
+  context_.rover_id = rover_id_;
+  if (source_ != nullptr) context_.base_late = source_->base_late();
+  context_.malformed_samples = malformed_payloads();
+  if (live_vio_ != nullptr) {
+    const pipeline::LiveVioCounts vio = live_vio_->counts();
+    context_.vio_dropped = vio.dropped;
+    context_.vio_late = vio.late_epochs;
+  }
+  if (pipeline_ != nullptr) {
+    context_.queue_depth = pipeline_->queue_depths();
+    context_.queue_full_waits = pipeline_->stats().full_waits;
+  }
+  context_.alignment_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  if (item.output && item.output->alignment) {
+    context_.alignment_rmse_m = item.output->alignment->rmse_m;
+    context_.alignment_eigen_ratio = item.output->alignment->first_eigenvalue_ratio;
+    context_.lever_arm_m = item.output->alignment->t_IA_m;
+  }
+}
+
+void RoverOutputs::taken(pipeline::Stage stage, const pipeline::EpochItem& item) {
+  if (stage != pipeline::Stage::Ambiguity) return;
+  update_context(item);
+  auto solution = to_msg_solution(item, context_);
+  if (!solution_->write(solution)) refused_.fetch_add(1);
+  timing_pending_ = to_msg_timing(item, context_);
+  if (prior_) {
+    prior_pending_ = to_msg_prior(item);
+    float_pending_ = to_msg_float(item);
+  }
+  if (bridged_) bridged_pending_ = to_msg_bridged(item);
+  if (alignment_) alignment_pending_ = to_msg_alignment(item);
+}
+
+void RoverOutputs::handed_on(pipeline::Stage stage) {
+  if (stage != pipeline::Stage::Ambiguity) return;
+  write_pending(timing_, timing_pending_, refused_);
+  write_pending(bridged_, bridged_pending_, refused_);
+  write_pending(prior_, prior_pending_, refused_);
+  write_pending(float_, float_pending_, refused_);
+  write_pending(alignment_, alignment_pending_, refused_);
+}
+
+Status RoverOutputs::close_pos() {
+  if (!pos_) return Ok{};
+  return pos_->close();
+}
+
+bool RoverOutputs::wait_for_acknowledgments(double timeout_s) {
+  return solution_->wait_for_acknowledgments(timeout_s) && timing_->wait_for_acknowledgments(timeout_s);
+}
+
+}  // namespace canyon::dds
