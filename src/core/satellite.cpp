@@ -272,4 +272,36 @@ bool ConstellationFlags::set_from_letters(const std::vector<std::string>& letter
   return true;
 }
 
+const char* code_priority(Constellation system, char band) {
+  switch (system) {
+    case Constellation::Gps:
+      switch (band) {
+        case '1': return "CPWYMSLXN";
+        case '2': return "WPYCLSXMDN";
+        case '5': return "QXI";
+        default: return "";
+      }
+    case Constellation::Glonass: return band == '1' || band == '2' ? "CP" : "QXI";
+    case Constellation::Galileo:
+      switch (band) {
+        case '1': return "CXBAZ";
+        case '5':
+        case '7':
+        case '8': return "QXI";
+        case '6': return "CXBAZ";
+        default: return "";
+      }
+    case Constellation::BeiDou: return "IQXDPZ";
+    case Constellation::Qzss:
+      switch (band) {
+        case '1': return "CSLXBEZ";  // L1Z (L1-SAIF) last: a different signal
+        case '2': return "LXS";
+        case '5': return "QXIDPZ";
+        case '6': return "LXSEZ";
+        default: return "";
+      }
+  }
+  return "";
+}
+
 }  // namespace canyon::core

@@ -63,36 +63,6 @@ struct Linearised {
   bool have_position = false;  // the position was on the ground: elevation mask and atmosphere applied
 };
 
-/// Preferred tracking attributes on each system's first frequency, best first.
-std::string_view attribute_priority(Constellation system) {
-  switch (system) {
-    case Constellation::Gps: return "CPYWMLSX";
-    case Constellation::Glonass: return "CP";
-    case Constellation::Galileo: return "CBXAZ";
-    case Constellation::BeiDou: return "IQX";
-    case Constellation::Qzss: return "CSLXZ";
-  }
-  return "";
-}
-
-/// The first-frequency signal with a pseudorange, by attribute priority.
-const core::SignalObs* select_signal(const core::SatelliteObs& sat_obs) {
-  const core::SignalObs* best = nullptr;
-  std::size_t best_rank = std::string_view::npos;
-  const std::string_view priority = attribute_priority(sat_obs.sat.system);
-  for (const core::SignalObs& s : sat_obs.signals) {
-    if (!core::has_value(s.pseudorange_m) || s.pseudorange_m < 1e6 || s.pseudorange_m > 1e8) continue;
-    if (core::frequency_rank(sat_obs.sat.system, s.code.band) != 0) continue;
-    const std::size_t pos = priority.find(s.code.attribute);
-    const std::size_t rank = pos == std::string_view::npos ? priority.size() : pos;
-    if (best == nullptr || rank < best_rank) {
-      best = &s;
-      best_rank = rank;
-    }
-  }
-  return best;
-}
-
 int clock_index(Constellation system, const SppOptions& o) {
   if (system == Constellation::Qzss && !o.qzss_own_clock) return static_cast<int>(Constellation::Gps);
   return static_cast<int>(system);
@@ -105,7 +75,7 @@ std::vector<Measurement> prepare_measurements(const core::ObsEpoch& epoch, const
   for (const core::SatelliteObs& sat_obs : epoch.sats) {
     if (!options.uses(sat_obs.sat.system)) continue;
     if (std::find(options.excluded.begin(), options.excluded.end(), sat_obs.sat) != options.excluded.end()) continue;
-    const core::SignalObs* signal = select_signal(sat_obs);
+    const core::SignalObs* signal = spp_signal(sat_obs);
     if (signal == nullptr) continue;
     const bool with_velocity = core::has_value(signal->doppler_hz);  // satellite velocity serves Doppler only
     const auto state = states.at_reception(sat_obs.sat, signal->pseudorange_m, with_velocity);
@@ -467,6 +437,23 @@ Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore&
   sol.residual_rms_m = std::sqrt(fix->lin.v.squaredNorm() / static_cast<double>(fix->lin.v.size()));
   sol.v_E_mps = solve_velocity(ms, fix->lin, sol.p_E_m);
   return sol;
+}
+
+const core::SignalObs* spp_signal(const core::SatelliteObs& sat_obs) {
+  const core::SignalObs* best = nullptr;
+  std::size_t best_rank = std::string_view::npos;
+  for (const core::SignalObs& s : sat_obs.signals) {
+    if (!core::has_value(s.pseudorange_m) || s.pseudorange_m < 1e6 || s.pseudorange_m > 1e8) continue;
+    if (core::frequency_rank(sat_obs.sat.system, s.code.band) != 0) continue;
+    const std::string_view priority = core::code_priority(sat_obs.sat.system, s.code.band);
+    const std::size_t pos = priority.find(s.code.attribute);
+    const std::size_t rank = pos == std::string_view::npos ? priority.size() : pos;
+    if (best == nullptr || rank < best_rank) {
+      best = &s;
+      best_rank = rank;
+    }
+  }
+  return best;
 }
 
 }  // namespace canyon::gnss

@@ -16,45 +16,13 @@ using core::Constellation;
 /// Rank of a signal among the candidates of its (system, frequency): lower is better. Signals with carrier phase
 /// come first, then by code priority.
 int signal_rank(Constellation system, const core::SignalObs& s) {
-  const char* priority = code_priority(system, s.code.band);
+  const char* priority = core::code_priority(system, s.code.band);
   const char* found = std::strchr(priority, s.code.attribute);
   const int code_rank = found != nullptr ? static_cast<int>(found - priority) : 50;
   return (core::has_value(s.carrier_phase_cyc) ? 0 : 100) + code_rank;
 }
 
 }  // namespace
-
-const char* code_priority(Constellation system, char band) {
-  switch (system) {
-    case Constellation::Gps:
-      switch (band) {
-        case '1': return "CPWYMSLXN";
-        case '2': return "WPYCLSXMDN";
-        case '5': return "QXI";
-        default: return "";
-      }
-    case Constellation::Glonass: return band == '1' || band == '2' ? "CP" : "QXI";
-    case Constellation::Galileo:
-      switch (band) {
-        case '1': return "CXBAZ";
-        case '5':
-        case '7':
-        case '8': return "QXI";
-        case '6': return "CXBAZ";
-        default: return "";
-      }
-    case Constellation::BeiDou: return "IQXDPZ";
-    case Constellation::Qzss:
-      switch (band) {
-        case '1': return "CSLXBEZ";  // L1Z (L1-SAIF) last: a different signal
-        case '2': return "LXS";
-        case '5': return "QXIDPZ";
-        case '6': return "LXSEZ";
-        default: return "";
-      }
-  }
-  return "";
-}
 
 const SignalObservable* ReceiverObservables::find(core::SatelliteId sat, int frequency) const {
   const auto it = std::lower_bound(signals.begin(), signals.end(), std::pair{sat, frequency},

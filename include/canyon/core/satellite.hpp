@@ -75,6 +75,12 @@ inline constexpr int kNoGlonassChannel = 99;
 /// nullopt for a band the system does not have.
 [[nodiscard]] std::optional<int> frequency_rank(Constellation system, char band);
 
+/// Tracking-code preference on a system's band, best first (e.g. GPS L1: "CPWYMSLXN"): the one table by which the
+/// single point (gnss/spp.hpp) and the RTK filter's observables (rtk/observables.hpp) choose among the signals a
+/// receiver tracks on one band of one satellite, so that both use the same signal. "" for a band the system does not
+/// have.
+[[nodiscard]] const char* code_priority(Constellation system, char band);
+
 }  // namespace canyon::core
 
 namespace canyon::core {

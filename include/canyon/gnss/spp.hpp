@@ -70,4 +70,8 @@ Result<SppSolution> solve_spp(const core::ObsEpoch& epoch, const EphemerisStore&
                               const std::optional<Eigen::Vector3d>& initial_p_E_m = {},
                               EpochSatelliteStates* states = nullptr);
 
+/// The signal of a satellite the single point uses: its first-frequency signal with a plausible pseudorange, the
+/// best by core::code_priority (the table the RTK filter's observables use too); nullptr if none.
+[[nodiscard]] const core::SignalObs* spp_signal(const core::SatelliteObs& sat_obs);
+
 }  // namespace canyon::gnss

@@ -56,7 +56,4 @@ struct ObservableOptions : core::ConstellationFlags {  // use_gps ... use_qzss: 
 [[nodiscard]] ReceiverObservables select_observables(const core::ObsEpoch& epoch, const gnss::EphemerisStore& eph,
                                                      const ObservableOptions& options);
 
-/// Tracking-code preference on a system's band, best first (e.g. GPS band 2: "WPYLSXD...").
-[[nodiscard]] const char* code_priority(core::Constellation system, char band);
-
 }  // namespace canyon::rtk
