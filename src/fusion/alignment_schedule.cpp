@@ -129,8 +129,8 @@ void AlignmentSchedule::try_coarse(const core::GpsTime& t, int segment) {
   const auto coarse = try_coarse_alignment(history_, t, segment, alignment_, t_IA_m_, coarse_, options_.fit, points);
   if (!coarse) return;
   alignment_ = VioAlignment{coarse->T_EO, segment, coarse->yaw_sigma_rad, false, t};
-  stats_.events.push_back(
-      AlignmentEvent{t, "coarse", points, 0.0, coarse->rmse_m, coarse->rmse_m, coarse->yaw_sigma_rad * core::kRadToDeg});
+  stats_.events.push_back(AlignmentEvent{t, "coarse", points, 0.0, coarse->rmse_m, coarse->rmse_m,
+                                         coarse->yaw_sigma_rad * core::kRadToDeg});
 }
 
 std::vector<AlignmentPoint> AlignmentSchedule::window(const core::GpsTime& t, int segment, bool fixed_only) const {

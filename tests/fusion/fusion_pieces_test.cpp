@@ -40,9 +40,9 @@ TEST(FusionPieces, PredictWithVioIsEqsThreeToSix) {
   in.R_EO = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, 0.3, 0.9).normalized()).toRotationMatrix();
   const MotionPrediction p = predict_with_vio(in, PredictionOptions{});
   const Eigen::Vector3d dp_O = in.T_OI_next.q * in.t_IA_m + in.T_OI_next.p - (in.T_OI_i.q * in.t_IA_m + in.T_OI_i.p);
-  EXPECT_LT((p.increment.dp_O_m - dp_O).norm(), 1e-12);                        // the antenna's increment
-  EXPECT_LT((p.dp_E_m - in.R_EO * dp_O).norm(), 1e-12);                        // Eq. 5
-  EXPECT_LT((p.prior.p_E_m - (kP0 + in.R_EO * dp_O)).norm(), 1e-9);            // Eq. 3
+  EXPECT_LT((p.increment.dp_O_m - dp_O).norm(), 1e-12);                            // the antenna's increment
+  EXPECT_LT((p.dp_E_m - in.R_EO * dp_O).norm(), 1e-12);                            // Eq. 5
+  EXPECT_LT((p.prior.p_E_m - (kP0 + in.R_EO * dp_O)).norm(), 1e-9);                // Eq. 3
   EXPECT_LT((p.prior.P_E_m2 - (in.P_E_m2 + p.increment.cov_E_m2)).norm(), 1e-15);  // Eq. 6
   EXPECT_LT((p.increment.cov_E_m2 - in.R_EO * p.increment.cov_O_m2 * in.R_EO.transpose()).norm(), 1e-15);
   // Eq. 4 with the joint covariance sigma^2 I: J J^T sigma^2, J = [-R_i (.. ) | R_i+1 (..)]: at least both
@@ -119,16 +119,16 @@ TEST(FusionPieces, FloatValidationAndTheFillIn) {
   none.num_dd_measurements = 0;
   EXPECT_EQ(validate_float(none, options), "no double-differenced phase");
   // Line 22: the filter's prior with status VIO fill-in, or the fusion's when the filter's time update did not run.
-  const core::Solution fill = vio_fill_in(far, Prior{kP0 + Eigen::Vector3d::Ones(), Eigen::Matrix3d::Identity()},
-                                          core::GpsTime{2200, 10.0});
+  const core::Solution fill =
+      vio_fill_in(far, Prior{kP0 + Eigen::Vector3d::Ones(), Eigen::Matrix3d::Identity()}, core::GpsTime{2200, 10.0});
   EXPECT_EQ(fill.status, core::SolutionStatus::VioFillIn);
   EXPECT_EQ(fill.p_E_m, kP0);
   EXPECT_DOUBLE_EQ(fill.ratio, 0.0);
   rtk::RtkEpoch not_aided = far;
   not_aided.aided = false;
   not_aided.solution.status = core::SolutionStatus::None;
-  const core::Solution from_fusion = vio_fill_in(not_aided, Prior{kP0 + Eigen::Vector3d::Ones(), Eigen::Matrix3d()},
-                                                 core::GpsTime{2200, 10.0});
+  const core::Solution from_fusion =
+      vio_fill_in(not_aided, Prior{kP0 + Eigen::Vector3d::Ones(), Eigen::Matrix3d()}, core::GpsTime{2200, 10.0});
   EXPECT_EQ(from_fusion.p_E_m, kP0 + Eigen::Vector3d::Ones());
   EXPECT_DOUBLE_EQ(from_fusion.time.tow_s, 10.0);
 }
@@ -201,12 +201,13 @@ TEST(FusionPieces, TheIntegrityCheckRestartsWhenTheMedianSinglePointIsFarOff) {
   const Eigen::Vector3d moved_N = R_EN.transpose() * (restart->p_E_m - kP0);
   EXPECT_NEAR(moved_N.x(), 31.0, 1e-6);  // the median east offset
   EXPECT_NEAR(moved_N.y(), -5.0, 1e-6);
-  EXPECT_NEAR(moved_N.z(), 0.0, 1e-6);   // the vertical stays
+  EXPECT_NEAR(moved_N.z(), 0.0, 1e-6);  // the vertical stays
   EXPECT_NEAR(restart->offset_m, std::hypot(31.0, 5.0), 1e-6);
   // Points close to the output never restart; no single point, no test.
   IntegrityCheck quiet(options);
   for (int k = 0; k < 20; ++k) {
-    EXPECT_FALSE(quiet.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, kP0 + R_EN * Eigen::Vector3d(3, 0, 0)));
+    EXPECT_FALSE(
+        quiet.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, kP0 + R_EN * Eigen::Vector3d(3, 0, 0)));
     EXPECT_FALSE(quiet.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, std::nullopt));
   }
 }
@@ -218,7 +219,7 @@ TEST(FusionPieces, TheHeadingStateCouplesTheIncrementAndFoldsItsEstimate) {
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d dp(1000.0, 0.0, 0.0);
   couple_heading(motion, dp, up, alignment, HeadingStateOptions{});
-  EXPECT_EQ(motion.dp_d_heading_E_m, Eigen::Vector3d(0.0, 1000.0, 0.0));  // up x dp
+  EXPECT_EQ(motion.dp_d_heading_E_m, Eigen::Vector3d(0.0, 1000.0, 0.0));        // up x dp
   EXPECT_NEAR(motion.heading_noise_rad2, std::pow(core::kDegToRad, 2), 1e-18);  // 1 deg / sqrt(km) over 1 km
   EXPECT_DOUBLE_EQ(motion.heading_variance_rad2, 0.0025);
   EXPECT_TRUE(motion.restart_heading);

@@ -28,12 +28,12 @@
 namespace canyon::fusion {
 
 struct AlignmentScheduleOptions {
-  AlignmentOptions fit;               ///< FER 0.97, RMSE 0.1 m (the paper's gates)
-  double window_s = 6.0;              ///< an alignment window: the last this many seconds of solutions (s)
-  double interval_s = 1.0;            ///< until aligned, try at most this often (s)
-  double realign_interval_s = 5.0;    ///< once aligned, refresh T_EO this often (s)
-  double max_window_sigma_m = 0.3;    ///< solutions with a larger 3-D position sigma do not join a window (m)
-  bool calibrate_lever_arm = true;    ///< estimate t_IA in the first alignment (pass 2)
+  AlignmentOptions fit;             ///< FER 0.97, RMSE 0.1 m (the paper's gates)
+  double window_s = 6.0;            ///< an alignment window: the last this many seconds of solutions (s)
+  double interval_s = 1.0;          ///< until aligned, try at most this often (s)
+  double realign_interval_s = 5.0;  ///< once aligned, refresh T_EO this often (s)
+  double max_window_sigma_m = 0.3;  ///< solutions with a larger 3-D position sigma do not join a window (m)
+  bool calibrate_lever_arm = true;  ///< estimate t_IA in the first alignment (pass 2)
   Eigen::Vector3d lever_arm_prior_m = Eigen::Vector3d::Zero();  ///< t_IA prior (IMU frame, m)
 
   [[nodiscard]] std::string validate() const;

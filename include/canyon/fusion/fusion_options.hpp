@@ -23,13 +23,13 @@ namespace canyon::fusion {
 
 struct FusionOptions {
   // The paper's method.
-  bool vio_on_gps_time = false;         ///< vio.csv t_ns is GPST ns since 1980-01-06 (no time-sync file needed)
-  TimeBridgeOptions time_sync;          ///< the VIO clock to GPST (time_bridge.hpp)
-  VioTrackOptions vio;                  ///< VIO segments, interpolation (vio_track.hpp)
-  AlignmentScheduleOptions alignment;   ///< T_EO and t_IA, the paper's gates (alignment_schedule.hpp)
-  PredictionOptions prediction;         ///< Eqs. 3-6 (vio_prediction.hpp)
-  GateOptions gates;                    ///< outlier satellite pruning in the update (innovation_gates.hpp)
-  FloatValidationOptions validation;    ///< (float_validation.hpp)
+  bool vio_on_gps_time = false;        ///< vio.csv t_ns is GPST ns since 1980-01-06 (no time-sync file needed)
+  TimeBridgeOptions time_sync;         ///< the VIO clock to GPST (time_bridge.hpp)
+  VioTrackOptions vio;                 ///< VIO segments, interpolation (vio_track.hpp)
+  AlignmentScheduleOptions alignment;  ///< T_EO and t_IA, the paper's gates (alignment_schedule.hpp)
+  PredictionOptions prediction;        ///< Eqs. 3-6 (vio_prediction.hpp)
+  GateOptions gates;                   ///< outlier satellite pruning in the update (innovation_gates.hpp)
+  FloatValidationOptions validation;   ///< (float_validation.hpp)
   // Beyond the paper, each in its own header.
   Cn0ScreenOptions cn0;
   CoarseAlignmentOptions coarse;

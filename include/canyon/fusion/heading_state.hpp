@@ -8,11 +8,10 @@
 // state restarts at zero with its variance kept; it starts at the coarse fit's yaw sigma or at fine_sigma_deg after a
 // fine alignment, and walks by random_walk_deg_per_sqrt_km with the distance.
 
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
-
-#include <optional>
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/se3.hpp"

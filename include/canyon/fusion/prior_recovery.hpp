@@ -14,9 +14,9 @@
 namespace canyon::fusion {
 
 struct PriorRecoveryOptions {
-  int max_prior_rejections = 5;    ///< consecutive prior-only validation failures before the float is taken
-  int gate_conflict_epochs = 5;    ///< consecutive epochs gating more rows than used before the prior is widened
-  double reanchor_sigma_m = 2.0;   ///< the widening (m, per axis)
+  int max_prior_rejections = 5;   ///< consecutive prior-only validation failures before the float is taken
+  int gate_conflict_epochs = 5;   ///< consecutive epochs gating more rows than used before the prior is widened
+  double reanchor_sigma_m = 2.0;  ///< the widening (m, per axis)
 
   [[nodiscard]] std::string validate() const;
 };
