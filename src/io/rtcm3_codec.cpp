@@ -348,9 +348,17 @@ Result<Rtcm3Frame> Rtcm3Encoder::encode_ephemeris(const core::GlonassEphemeris& 
 Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch, std::vector<Rtcm3Frame>& out) {
   if (const std::string broken = options_.validate(); !broken.empty()) return Error{"RTCM 3 encoder: " + broken};
   Rtcm3EncodeReport report;
+  const std::array<std::size_t, core::kNumConstellations> used = collect_satellites(epoch, report);
+  const std::vector<PendingMessage> pending = split_into_messages(used);
+  for (std::size_t i = 0; i < pending.size(); ++i) {
+    if (Status s = emit_message(epoch.time, pending[i], i + 1 < pending.size(), out, report); !s) return s.error();
+  }
+  return report;
+}
 
+std::array<std::size_t, core::kNumConstellations> Rtcm3Encoder::collect_satellites(const core::ObsEpoch& epoch,
+                                                                                   Rtcm3EncodeReport& report) {
   // Satellites per constellation, in satellite order; the scratch objects (and their cell storage) are reused.
-  auto& per_system = per_system_;
   std::array<std::size_t, core::kNumConstellations> used{};
   for (const core::SatelliteObs& so : epoch.sats) {
     const Constellation system = so.sat.system;
@@ -359,7 +367,7 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
       const auto it = glonass_channel_.find(so.sat.prn);
       if (it != glonass_channel_.end()) channel = it->second;
     }
-    auto& slot = per_system[static_cast<std::size_t>(system)];
+    auto& slot = per_system_[static_cast<std::size_t>(system)];
     std::size_t& n = used[static_cast<std::size_t>(system)];
     if (n == slot.size()) slot.emplace_back();
     rtcm3::MsmSatellite& ms = slot[n];
@@ -380,53 +388,57 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
         ++report.unsupported_signals;
         continue;
       }
-      rtcm3::MsmCell cell;
-      cell.signal_id = *id;
-      cell.pseudorange_m = s.pseudorange_m;
-      cell.cnr_dbhz = s.snr_dbhz;
-      cell.half_cycle = (s.lli & core::kLliHalfCycle) != 0;
-      const std::optional<double> lambda = wavelength(system, s.code, channel);
-      if (core::has_value(s.carrier_phase_cyc) || core::has_value(s.doppler_hz)) {
-        if (!lambda) ++report.phase_without_channel;
-      }
-      if (lambda && core::has_value(s.doppler_hz)) cell.phase_range_rate_mps = -s.doppler_hz * *lambda;
-      if (lambda && core::has_value(s.carrier_phase_cyc) && core::has_value(reference_m)) {
-        const double own_m = core::has_value(s.pseudorange_m) ? s.pseudorange_m : reference_m;
-        Arc& arc = arcs_.at(so.sat, s.code);
-        const bool slip = (s.lli & core::kLliLossOfLock) != 0;
-        auto start_arc = [&]() {
-          arc.offset_cyc = std::round(s.carrier_phase_cyc - own_m / *lambda);
-          arc.start = epoch.time;
-          arc.valid = true;
-        };
-        if (!arc.valid || slip) start_arc();
-        double phase_m = (s.carrier_phase_cyc - arc.offset_cyc) * *lambda;
-        if (std::abs(phase_m - reference_m) > kMaxPhaseOffsetM) {
-          ++report.arc_restarts;
-          start_arc();
-          phase_m = (s.carrier_phase_cyc - arc.offset_cyc) * *lambda;
-        }
-        cell.phase_range_m = phase_m;
-        cell.lock_time_ms = std::max(0.0, (epoch.time - arc.start) * 1000.0);
-      } else if (const Arc* arc = arcs_.find(so.sat, s.code); arc != nullptr && arc->valid) {
-        // No phase this epoch, but the arc goes on (no loss of lock reported): its lock time keeps growing.
-        cell.lock_time_ms = std::max(0.0, (epoch.time - arc->start) * 1000.0);
-      }
-      ms.cells.push_back(cell);
+      ms.cells.push_back(make_cell(epoch.time, so.sat, s, *id, channel, reference_m, report));
     }
     if (!ms.cells.empty()) ++n;
   }
+  return used;
+}
 
-  // Messages: per constellation, satellites split so that each message has at most 64 cells.
-  struct Pending {
-    Constellation system;
-    std::size_t first;
-    std::size_t count;
-  };
-  std::vector<Pending> pending;
+rtcm3::MsmCell Rtcm3Encoder::make_cell(const core::GpsTime& t, const core::SatelliteId& sat, const core::SignalObs& s,
+                                       int signal_id, int channel, double reference_m, Rtcm3EncodeReport& report) {
+  rtcm3::MsmCell cell;
+  cell.signal_id = signal_id;
+  cell.pseudorange_m = s.pseudorange_m;
+  cell.cnr_dbhz = s.snr_dbhz;
+  cell.half_cycle = (s.lli & core::kLliHalfCycle) != 0;
+  const std::optional<double> lambda = wavelength(sat.system, s.code, channel);
+  if (core::has_value(s.carrier_phase_cyc) || core::has_value(s.doppler_hz)) {
+    if (!lambda) ++report.phase_without_channel;
+  }
+  if (lambda && core::has_value(s.doppler_hz)) cell.phase_range_rate_mps = -s.doppler_hz * *lambda;
+  if (lambda && core::has_value(s.carrier_phase_cyc) && core::has_value(reference_m)) {
+    const double own_m = core::has_value(s.pseudorange_m) ? s.pseudorange_m : reference_m;
+    Arc& arc = arcs_.at(sat, s.code);
+    const bool slip = (s.lli & core::kLliLossOfLock) != 0;
+    auto start_arc = [&]() {
+      arc.offset_cyc = std::round(s.carrier_phase_cyc - own_m / *lambda);
+      arc.start = t;
+      arc.valid = true;
+    };
+    if (!arc.valid || slip) start_arc();
+    double phase_m = (s.carrier_phase_cyc - arc.offset_cyc) * *lambda;
+    if (std::abs(phase_m - reference_m) > kMaxPhaseOffsetM) {
+      ++report.arc_restarts;
+      start_arc();
+      phase_m = (s.carrier_phase_cyc - arc.offset_cyc) * *lambda;
+    }
+    cell.phase_range_m = phase_m;
+    cell.lock_time_ms = std::max(0.0, (t - arc.start) * 1000.0);
+  } else if (const Arc* arc = arcs_.find(sat, s.code); arc != nullptr && arc->valid) {
+    // No phase this epoch, but the arc goes on (no loss of lock reported): its lock time keeps growing.
+    cell.lock_time_ms = std::max(0.0, (t - arc->start) * 1000.0);
+  }
+  return cell;
+}
+
+std::vector<Rtcm3Encoder::PendingMessage> Rtcm3Encoder::split_into_messages(
+    const std::array<std::size_t, core::kNumConstellations>& used) {
+  // Per constellation, satellites split so that each message has at most 64 cells.
+  std::vector<PendingMessage> pending;
   pending.reserve(8);
-  for (std::size_t k = 0; k < per_system.size(); ++k) {
-    auto& sats = per_system[k];
+  for (std::size_t k = 0; k < per_system_.size(); ++k) {
+    auto& sats = per_system_[k];
     const std::size_t nsat = used[k];
     std::sort(
         sats.begin(), sats.begin() + static_cast<std::ptrdiff_t>(nsat),
@@ -444,37 +456,39 @@ Result<Rtcm3EncodeReport> Rtcm3Encoder::encode_epoch(const core::ObsEpoch& epoch
         ++count;
       }
       if (count == 0) count = 1;  // a satellite with more than 64 signals cannot exist (32 ids)
-      pending.push_back(Pending{static_cast<Constellation>(k), first, count});
+      pending.push_back(PendingMessage{static_cast<Constellation>(k), first, count});
       first += count;
     }
   }
-  for (std::size_t i = 0; i < pending.size(); ++i) {
-    const Pending& p = pending[i];
-    rtcm3::MsmMessage& msm = msm_;
-    msm.header = rtcm3::MsmHeader{};
-    msm.header.system = p.system;
-    msm.header.type = options_.msm_type;
-    msm.header.station_id = options_.station_id;
-    msm.header.epoch_time = rtcm3::msm_epoch_field(p.system, epoch.time, options_.leaps);
-    msm.header.multiple_message = i + 1 < pending.size();
-    auto& sats = per_system[static_cast<std::size_t>(p.system)];
-    msm.satellites.resize(p.count);
-    for (std::size_t k = 0; k < p.count; ++k) msm.satellites[k] = sats[p.first + k];  // reuses cell storage
-    payload_.clear();
-    auto encoded = rtcm3::append_msm(msm, payload_);
-    if (!encoded) return encoded.error();
-    report.cells += encoded->cells;
-    report.invalid_values += encoded->invalid_values;
-    report.dropped_satellites += encoded->dropped_satellites;
-    Rtcm3Frame frame;
-    frame.message_number = rtcm3::msm_message_number(p.system, options_.msm_type);
-    frame.epoch_time = epoch.time;
-    frame.bytes.reserve(payload_.size() + 6);
-    if (Status s = rtcm3::append_frame(payload_, frame.bytes); !s.ok()) return s.error();
-    out.push_back(std::move(frame));
-    ++report.messages;
-  }
-  return report;
+  return pending;
+}
+
+Status Rtcm3Encoder::emit_message(const core::GpsTime& t, const PendingMessage& p, bool more_follow,
+                                  std::vector<Rtcm3Frame>& out, Rtcm3EncodeReport& report) {
+  rtcm3::MsmMessage& msm = msm_;
+  msm.header = rtcm3::MsmHeader{};
+  msm.header.system = p.system;
+  msm.header.type = options_.msm_type;
+  msm.header.station_id = options_.station_id;
+  msm.header.epoch_time = rtcm3::msm_epoch_field(p.system, t, options_.leaps);
+  msm.header.multiple_message = more_follow;
+  auto& sats = per_system_[static_cast<std::size_t>(p.system)];
+  msm.satellites.resize(p.count);
+  for (std::size_t k = 0; k < p.count; ++k) msm.satellites[k] = sats[p.first + k];  // reuses cell storage
+  payload_.clear();
+  auto encoded = rtcm3::append_msm(msm, payload_);
+  if (!encoded) return encoded.error();
+  report.cells += encoded->cells;
+  report.invalid_values += encoded->invalid_values;
+  report.dropped_satellites += encoded->dropped_satellites;
+  Rtcm3Frame frame;
+  frame.message_number = rtcm3::msm_message_number(p.system, options_.msm_type);
+  frame.epoch_time = t;
+  frame.bytes.reserve(payload_.size() + 6);
+  if (Status s = rtcm3::append_frame(payload_, frame.bytes); !s.ok()) return s.error();
+  out.push_back(std::move(frame));
+  ++report.messages;
+  return Ok{};
 }
 
 }  // namespace canyon::io

@@ -144,6 +144,85 @@ void StreamClient::run() {
   finished_ = true;
 }
 
+bool StreamClient::start_ntrip(const Fd& fd, const std::string& where, std::vector<std::uint8_t>& data,
+                               ChunkedDecoder& chunked, bool& is_chunked) {
+  ClientRequestOptions r;
+  r.host = options_.host;
+  r.port = options_.port;
+  r.mount = options_.mount;
+  r.version = options_.ntrip_version;
+  r.user = options_.user;
+  r.password = options_.password;
+  if (Status s = send_all(fd, format_ntrip_request(r), options_.connect_timeout_ms); !s.ok()) {
+    fail(where + ": " + s.error().message);
+    return false;
+  }
+  auto header = read_header(fd, options_.connect_timeout_ms, &running_);
+  if (!header) {
+    fail(where + ": " + header.error().message);
+    return false;
+  }
+  auto response = parse_ntrip_response(header->first);
+  if (!response) {
+    fail(where + ": " + response.error().message);
+    return false;
+  }
+  switch (response->kind) {
+    case NtripResponse::Kind::Data: break;
+    case NtripResponse::Kind::SourceTable:
+      fail(where + ": the caster answered with its source table (mount point unknown)");
+      return false;
+    case NtripResponse::Kind::Unauthorized: fail(where + ": 401 unauthorized (user/password)"); return false;
+    case NtripResponse::Kind::NotFound: fail(where + ": 404 mount point not found"); return false;
+    case NtripResponse::Kind::Error: fail(where + ": caster answered '" + response->status_line + "'"); return false;
+  }
+  is_chunked = response->chunked;
+  const std::string& rest = header->second;
+  const std::span<const std::uint8_t> first(reinterpret_cast<const std::uint8_t*>(rest.data()), rest.size());
+  if (!is_chunked) {
+    data.assign(first.begin(), first.end());
+    return true;
+  }
+  if (Status s = chunked.feed(first, data); !s.ok()) {
+    fail(where + ": " + s.error().message);
+    return false;
+  }
+  return true;
+}
+
+bool StreamClient::upload_gga_if_due(const Fd& fd, const std::string& where, Clock::time_point& last_gga) {
+  std::string line;
+  if (options_.mode == StreamClientOptions::Mode::Ntrip && options_.gga_interval_s > 0.0 &&
+      seconds_since(last_gga) >= options_.gga_interval_s) {
+    const std::lock_guard lock(mutex_);
+    line = options_.gga;
+  }
+  if (line.empty()) return true;
+  if (line.size() < 2 || line.substr(line.size() - 2) != "\r\n") line += "\r\n";
+  if (Status s = send_all(fd, line, options_.connect_timeout_ms); !s.ok()) {
+    fail(where + ": GGA upload: " + s.error().message);
+    return false;
+  }
+  const std::lock_guard lock(mutex_);
+  ++stats_.gga_sent;
+  last_gga = Clock::now();
+  return true;
+}
+
+void StreamClient::deliver(std::vector<std::uint8_t>& data, bool& delivered) {
+  if (!delivered) {
+    const std::lock_guard lock(mutex_);
+    ++stats_.connections;
+  }
+  delivered = true;
+  {
+    const std::lock_guard lock(mutex_);
+    stats_.bytes += data.size();
+  }
+  on_data_(data);
+  data.clear();
+}
+
 bool StreamClient::session() {
   const std::string where = options_.host + ":" + std::to_string(options_.port) +
                             (options_.mode == StreamClientOptions::Mode::Ntrip ? "/" + options_.mount : "");
@@ -155,48 +234,8 @@ bool StreamClient::session() {
   std::vector<std::uint8_t> data;
   ChunkedDecoder chunked;
   bool is_chunked = false;
-  if (options_.mode == StreamClientOptions::Mode::Ntrip) {
-    ClientRequestOptions r;
-    r.host = options_.host;
-    r.port = options_.port;
-    r.mount = options_.mount;
-    r.version = options_.ntrip_version;
-    r.user = options_.user;
-    r.password = options_.password;
-    if (Status s = send_all(*fd, format_ntrip_request(r), options_.connect_timeout_ms); !s.ok()) {
-      fail(where + ": " + s.error().message);
-      return false;
-    }
-    auto header = read_header(*fd, options_.connect_timeout_ms, &running_);
-    if (!header) {
-      fail(where + ": " + header.error().message);
-      return false;
-    }
-    auto response = parse_ntrip_response(header->first);
-    if (!response) {
-      fail(where + ": " + response.error().message);
-      return false;
-    }
-    switch (response->kind) {
-      case NtripResponse::Kind::Data: break;
-      case NtripResponse::Kind::SourceTable:
-        fail(where + ": the caster answered with its source table (mount point unknown)");
-        return false;
-      case NtripResponse::Kind::Unauthorized: fail(where + ": 401 unauthorized (user/password)"); return false;
-      case NtripResponse::Kind::NotFound: fail(where + ": 404 mount point not found"); return false;
-      case NtripResponse::Kind::Error: fail(where + ": caster answered '" + response->status_line + "'"); return false;
-    }
-    is_chunked = response->chunked;
-    const std::string& rest = header->second;
-    const std::span<const std::uint8_t> first(reinterpret_cast<const std::uint8_t*>(rest.data()), rest.size());
-    if (is_chunked) {
-      if (Status s = chunked.feed(first, data); !s.ok()) {
-        fail(where + ": " + s.error().message);
-        return false;
-      }
-    } else {
-      data.assign(first.begin(), first.end());
-    }
+  if (options_.mode == StreamClientOptions::Mode::Ntrip && !start_ntrip(*fd, where, data, chunked, is_chunked)) {
+    return false;
   }
   if (on_event_) on_event_("connected to " + where);
   bool delivered = false;
@@ -205,35 +244,10 @@ bool StreamClient::session() {
   char buffer[16384];
   while (running_.load()) {
     if (!data.empty()) {
-      if (!delivered) {
-        const std::lock_guard lock(mutex_);
-        ++stats_.connections;
-      }
-      delivered = true;
-      {
-        const std::lock_guard lock(mutex_);
-        stats_.bytes += data.size();
-      }
-      on_data_(data);
-      data.clear();
+      deliver(data, delivered);
       last_data = Clock::now();
     }
-    std::string line;
-    if (options_.mode == StreamClientOptions::Mode::Ntrip && options_.gga_interval_s > 0.0 &&
-        seconds_since(last_gga) >= options_.gga_interval_s) {
-      const std::lock_guard lock(mutex_);
-      line = options_.gga;
-    }
-    if (!line.empty()) {
-      if (line.size() < 2 || line.substr(line.size() - 2) != "\r\n") line += "\r\n";
-      if (Status s = send_all(*fd, line, options_.connect_timeout_ms); !s.ok()) {
-        fail(where + ": GGA upload: " + s.error().message);
-        return delivered;
-      }
-      const std::lock_guard lock(mutex_);
-      ++stats_.gga_sent;
-      last_gga = Clock::now();
-    }
+    if (!upload_gga_if_due(*fd, where, last_gga)) return delivered;
     if (seconds_since(last_data) > options_.stall_timeout_s) {
       {
         const std::lock_guard lock(mutex_);
@@ -257,18 +271,18 @@ bool StreamClient::session() {
       return delivered;
     }
     const std::span<const std::uint8_t> got(reinterpret_cast<const std::uint8_t*>(buffer), static_cast<std::size_t>(n));
-    if (is_chunked) {
-      if (Status s = chunked.feed(got, data); !s.ok()) {
-        fail(where + ": " + s.error().message);
-        return delivered;
-      }
-      if (chunked.finished()) {
-        if (!data.empty()) on_data_(data);
-        fail(where + ": the caster ended the stream");
-        return delivered;
-      }
-    } else {
+    if (!is_chunked) {
       data.insert(data.end(), got.begin(), got.end());
+      continue;
+    }
+    if (Status s = chunked.feed(got, data); !s.ok()) {
+      fail(where + ": " + s.error().message);
+      return delivered;
+    }
+    if (chunked.finished()) {
+      if (!data.empty()) on_data_(data);
+      fail(where + ": the caster ended the stream");
+      return delivered;
     }
   }
   return delivered;

@@ -195,6 +195,22 @@ class Rtcm3Encoder {
   };
   /// Wavelength of a signal (cached per system and code; GLONASS: per channel, not cached).
   std::optional<double> wavelength(core::Constellation system, core::SignalCode code, int channel);
+  /// The epoch's satellites into per_system_, their cells made; the number of satellites used per constellation.
+  std::array<std::size_t, core::kNumConstellations> collect_satellites(const core::ObsEpoch& epoch,
+                                                                       Rtcm3EncodeReport& report);
+  /// One signal's MSM cell: its phase shifted by its arc's integer offset (a new arc at a slip or when the phase
+  /// strays), its lock time.
+  rtcm3::MsmCell make_cell(const core::GpsTime& t, const core::SatelliteId& sat, const core::SignalObs& s,
+                           int signal_id, int channel, double reference_m, Rtcm3EncodeReport& report);
+  /// A message's worth of a constellation's satellites: at most 64 cells.
+  struct PendingMessage {
+    core::Constellation system;
+    std::size_t first;
+    std::size_t count;
+  };
+  std::vector<PendingMessage> split_into_messages(const std::array<std::size_t, core::kNumConstellations>& used);
+  Status emit_message(const core::GpsTime& t, const PendingMessage& p, bool more_follow, std::vector<Rtcm3Frame>& out,
+                      Rtcm3EncodeReport& report);
 
   Rtcm3EncoderOptions options_;
   std::map<int, int> glonass_channel_;

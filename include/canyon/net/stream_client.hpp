@@ -9,6 +9,7 @@
 // Data and events go to callbacks on the client's thread.
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -20,6 +21,7 @@
 
 #include "canyon/core/result.hpp"
 #include "canyon/net/ntrip.hpp"
+#include "canyon/net/socket.hpp"
 
 namespace canyon::net {
 
@@ -79,6 +81,13 @@ class StreamClient {
   void run();
   /// One connection, until it fails or stop(); true if it delivered data.
   bool session();
+  /// The NTRIP request and the caster's answer; the data that came with it into `data`. False (reported) on failure.
+  bool start_ntrip(const Fd& fd, const std::string& where, std::vector<std::uint8_t>& data, ChunkedDecoder& chunked,
+                   bool& is_chunked);
+  /// The rover's GGA to the caster when the interval is due; false (reported) if the upload failed.
+  bool upload_gga_if_due(const Fd& fd, const std::string& where, std::chrono::steady_clock::time_point& last_gga);
+  /// `data` to the callback, counted.
+  void deliver(std::vector<std::uint8_t>& data, bool& delivered);
   void fail(const std::string& why);
   void sleep_interruptible(double seconds);
 
