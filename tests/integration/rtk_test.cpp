@@ -3,6 +3,7 @@
 // for; the ones still open (QZSS never worse, m8p, speed) are reported by tests/bench/rtk_vs_rtklib.sh.
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -307,7 +308,7 @@ TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
   }
   if (!unexplained.empty()) {
     GTEST_SKIP() << "RTKLIB rnx2rtkp not installed (scripts/setup.sh installs it): the fixes more than "
-                 << kMaxDistanceToRtklibFixM << " m from RTKLIB's (" << unexplained.front()
+                 << std::lround(kMaxDistanceToRtklibFixM * 1000.0) << " mm from RTKLIB's (" << unexplained.front()
                  << (unexplained.size() > 1 ? ", " + unexplained.back() : std::string()) << ") were not checked "
                  << "against RTKLIB without G14";
   }
