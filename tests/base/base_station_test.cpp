@@ -25,23 +25,50 @@ Result<config::BaseConfig> parse(const std::string& text) {
   return config::parse_base_config(YAML::Load(text), "base.yaml");
 }
 
+// config/base.yaml, what a user runs: a u-blox receiver on a serial port, DDS and NTRIP out. It loads and validates
+// without the receiver being there.
 TEST(BaseConfigTest, ShippedFileLoadsAndRoundTrips) {
   const std::string path = std::string(CANYON_SOURCE_DIR) + "/config/base.yaml";
   auto config = config::load_base_config(path);
   ASSERT_TRUE(config.ok()) << config.error().to_string();
   EXPECT_EQ(config->validate(), "");
-  EXPECT_EQ(config->station.id, 3034);
-  EXPECT_EQ(config->input.kind, config::BaseInputKind::Rinex);
+  EXPECT_EQ(config->input.kind, config::BaseInputKind::Ubx);
+  EXPECT_EQ(config->input.source, config::BaseInputSource::Serial);
+  EXPECT_EQ(config->input.path, "/dev/ttyACM0");  // a device: not resolved against the file's folder
+  EXPECT_EQ(config->input.baud, 115200);
+  EXPECT_FALSE(config->station.position_E_m.has_value());  // the user's surveyed position, documented in the file
   EXPECT_EQ(config->rtcm.msm, 7);
   EXPECT_TRUE(config->dds.enabled);
   EXPECT_TRUE(config->ntrip.enabled);
   EXPECT_EQ(config->ntrip.mountpoint, "CANYON");
-  // Relative paths are relative to the file's folder.
-  EXPECT_TRUE(fs::path(config->input.path).is_absolute() || config->input.path.rfind(CANYON_SOURCE_DIR, 0) == 0)
-      << config->input.path;
+  EXPECT_EQ(config->ntrip.port, 2101);
   auto again = config::parse_base_config(YAML::Load(config::to_yaml(*config)), "");
   ASSERT_TRUE(again.ok()) << again.error().to_string();
   EXPECT_EQ(*again, *config);
+}
+
+// tests/data/config/base.yaml, the replay of a recorded base from the shared datasets: its relative paths, resolved
+// against its folder, name the dataset's files.
+TEST(BaseConfigTest, DatasetFileLoadsAndRoundTrips) {
+  const std::string path = std::string(CANYON_TEST_DATA_DIR) + "/config/base.yaml";
+  auto config = config::load_base_config(path);
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(config->validate(), "");
+  EXPECT_EQ(config->station.id, 3034);
+  EXPECT_EQ(config->input.kind, config::BaseInputKind::Rinex);
+  EXPECT_EQ(config->input.source, config::BaseInputSource::File);
+  EXPECT_EQ(config->rtcm.msm, 7);
+  EXPECT_TRUE(config->dds.enabled);
+  EXPECT_TRUE(config->ntrip.enabled);
+  auto again = config::parse_base_config(YAML::Load(config::to_yaml(*config)), "");
+  ASSERT_TRUE(again.ok()) << again.error().to_string();
+  EXPECT_EQ(*again, *config);
+  const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "cssrlib-static-doy078";
+  if (!fs::exists(data)) GTEST_SKIP() << "shared dataset not present: " << data << " (the paths were not checked)";
+  const auto same_file = [](const fs::path& a, const fs::path& b) { return fs::exists(a) && fs::equivalent(a, b); };
+  EXPECT_TRUE(same_file(config->input.path, data / "3034078M1.21O")) << config->input.path;
+  ASSERT_EQ(config->input.nav.size(), 1U);
+  EXPECT_TRUE(same_file(config->input.nav[0], data / "SEPT078M.21P")) << config->input.nav[0];
 }
 
 TEST(BaseConfigTest, UnknownKeysAndBadValuesNameFileLineAndKey) {

@@ -7,7 +7,8 @@
 # scenario stay as shipped, so the variants differ only in what reaches the antenna.
 # Usage: tests/bench/fusion_bounds.sh [BUILD_DIR] [SEEDS] [SCENARIO]
 #   defaults: build, "1 2 3", urban-severe. KEEP=1 keeps the temp folder and prints its path.
-# Exit status: 0 done, 2 missing build or tools.
+# Exit status: 0 done, 1 a step failed (rnx2rtkp, canyon process or evaluate: its row shows "-" or "no evaluation",
+# the other rows still run; the failed steps are listed at the end), 2 missing build or tools.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -42,20 +43,21 @@ grep -q '^  multipath: false' "$tmp/no-reflections.yaml" || {
 
 printf '%-16s %4s  %-34s  %-34s  %-34s\n' variant seed "RTKLIB: fix (wrong), avail, RMSE" \
   "canyon rtk" "canyon fusion"
+failed=()
 for variant in shipped no-nlos no-reflections; do
   for seed in $seeds; do
     dir=$tmp/$variant-$seed
     "$canyon" simulate -q --scenario "$tmp/$variant.yaml" --seed "$seed" --out "$dir"
     rnx2rtkp -k "$root/config/rtklib/sim.conf" -o "$dir/rtklib.pos" "$dir/rover.obs" "$dir/base.obs" \
-      "$dir/nav.rnx" >/dev/null 2>&1 || true
+      "$dir/nav.rnx" >/dev/null 2>&1 || failed+=("$variant seed $seed: rnx2rtkp")
     "$canyon" process -q --config "$root/config/rtk-urban.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
-      --nav "$dir/nav.rnx" --out "$dir/rtk.pos" 2>"$dir/rtk.log" || true
+      --nav "$dir/nav.rnx" --out "$dir/rtk.pos" 2>"$dir/rtk.log" || failed+=("$variant seed $seed: canyon rtk")
     "$canyon" process -q --config "$root/config/fusion.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
       --nav "$dir/nav.rnx" --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" --out "$dir/fusion.pos" \
-      2>"$dir/fusion.log" || true
+      2>"$dir/fusion.log" || failed+=("$variant seed $seed: canyon fusion")
     "$canyon" evaluate -q --truth "$dir/truth.csv" --rover "$dir/rover.obs" --solution "$dir/rtklib.pos" \
       --label RTKLIB --solution "$dir/rtk.pos" --label rtk --solution "$dir/fusion.pos" --label fusion \
-      --json "$dir/evaluation.json" || true
+      --json "$dir/evaluation.json" || failed+=("$variant seed $seed: canyon evaluate")
     python3 - "$dir/evaluation.json" "$variant" "$seed" <<'PY'
 import json, sys
 path, variant, seed = sys.argv[1:4]
@@ -77,3 +79,7 @@ PY
 done
 echo "fix = fixed epochs / rover epochs; (wrong) = fixed epochs more than 0.10 m from the truth; avail = epochs with a"
 echo "solution; RMSE = 3D over those. no-nlos: reflections.nlos false; no-reflections: also multipath false."
+if ((${#failed[@]} > 0)); then
+  printf 'FAILED: %s\n' "${failed[@]}"
+  exit 1
+fi

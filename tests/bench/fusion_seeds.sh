@@ -6,7 +6,8 @@
 # epochs and wrong fixes (3D error > 0.10 m).
 # Usage: tests/bench/fusion_seeds.sh [BUILD_DIR] [FIRST] [LAST] [SCENARIO] [CONFIG]
 #   defaults: build, 1, 30, urban-severe, config/fusion.yaml. KEEP=1 keeps the temp folder and prints its path.
-# Exit status: 0 done, 2 missing build or tools.
+# Exit status: 0 done, 1 a step failed (rnx2rtkp, canyon process or evaluate: its seed's line says "no evaluation"
+# or lacks the figure, the other seeds still run; the failed steps are listed at the end), 2 missing build or tools.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -29,15 +30,18 @@ else
   trap 'rm -rf "$tmp"' EXIT
 fi
 
+failed=()
 for ((seed = first; seed <= last; ++seed)); do
   dir=$tmp/$scenario-$seed
   "$canyon" simulate -q --scenario "$scenario" --seed "$seed" --out "$dir"
   rnx2rtkp -k "$root/config/rtklib/sim.conf" -o "$dir/rtklib.pos" "$dir/rover.obs" "$dir/base.obs" "$dir/nav.rnx" \
-    >/dev/null 2>&1 || true
+    >/dev/null 2>&1 || failed+=("seed $seed: rnx2rtkp")
   "$canyon" process -q --config "$config" --rover "$dir/rover.obs" --base "$dir/base.obs" --nav "$dir/nav.rnx" \
-    --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" --out "$dir/fusion.pos" 2>"$dir/fusion.log" || true
+    --vio "$dir/vio.csv" --timesync "$dir/timesync.csv" --out "$dir/fusion.pos" 2>"$dir/fusion.log" ||
+    failed+=("seed $seed: canyon process (fusion)")
   "$canyon" evaluate -q --truth "$dir/truth.csv" --rover "$dir/rover.obs" --solution "$dir/rtklib.pos" \
-    --label RTKLIB --solution "$dir/fusion.pos" --label fusion --json "$dir/evaluation.json" || true
+    --label RTKLIB --solution "$dir/fusion.pos" --label fusion --json "$dir/evaluation.json" ||
+    failed+=("seed $seed: canyon evaluate")
   python3 - "$dir/evaluation.json" "$seed" "$tmp/seeds.tsv" <<'PY'
 import json, sys
 path, seed, table = sys.argv[1:4]
@@ -73,3 +77,7 @@ print("%d seeds: a solution at every epoch on %d, RMSE <= 1/5 of RTKLIB's on %d,
       % (len(rows), sum(int(r[2]) for r in rows), sum(int(r[3]) for r in rows),
          statistics.median(rmse) if rmse else float("nan"), fixed, wrong))
 PY
+if ((${#failed[@]} > 0)); then
+  printf 'FAILED: %s\n' "${failed[@]}"
+  exit 1
+fi

@@ -164,7 +164,10 @@ best_of() {
 # canyon process (rtk, threaded pipeline) against rnx2rtkp on instinct-spirent-rtk-sim, best of 5 each.
 throughput_instinct() {
   local d="${CANYON_SHARED_DATA_DIR:-${root}/../shared/data}/instinct-spirent-rtk-sim"
-  [[ -d "${d}" ]] || return 0
+  if [[ ! -d "${d}" ]]; then
+    echo "  instinct-spirent-rtk-sim: not measured: shared dataset not found at ${d}"
+    return 0
+  fi
   local rover="${d}/iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs" base="${d}/iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs"
   local nav="${d}/RINEX_GN_Spirent.23N" out="${work}/instinct"
   mkdir -p "${out}"

@@ -17,7 +17,8 @@
 #
 # Usage: tests/bench/rover_links.sh [BUILD_DIR] [WORK_DIR] [PARTS (default: base-canyon base-str2str ubx bad)]
 #   env BASE_PACE (default 50: canyon base replay speed), DOMAIN (default: 150 + PID % 80).
-# Exit 0 when every check passes, 1 otherwise, 77 when the shared data or RTKLIB's str2str is missing.
+# Exit 0 when every check passes, 1 otherwise, 77 (with a SKIP: line) when the shared data or RTKLIB's str2str is
+# missing.
 set -uo pipefail
 
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -41,11 +42,11 @@ m8p="${data}/m8p-galway-20181004"
 m8p_rover_ubx="${m8p}/20181004_rover-20181004-1532.ubx.gz"
 m8p_base="${m8p}/rinex/20181004_base-20181004-1452.obs"
 if [[ ! -d "${inst}" || ! -d "${m8p}" ]]; then
-  echo "rover_links: shared data not found at ${data} (instinct-spirent-rtk-sim, m8p-galway-20181004)"
+  echo "SKIP: rover_links: shared data not found at ${data} (instinct-spirent-rtk-sim, m8p-galway-20181004)"
   exit 77
 fi
 if ! command -v str2str > /dev/null; then
-  echo "rover_links: RTKLIB's str2str not installed (apt-get install rtklib)"
+  echo "SKIP: rover_links: RTKLIB's str2str not installed (scripts/setup.sh installs rtklib)"
   exit 77
 fi
 
@@ -130,7 +131,10 @@ declare -A rc
 
 part_base_canyon() {
   local dir="${work}/base-canyon"
-  rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}" || return
+  if ! { rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}"; }; then
+    fail base-canyon "cannot make ${dir}"
+    return
+  fi
   local ntrip_port tcp_port
   ntrip_port=$(free_port)
   tcp_port=$(free_port)
@@ -192,7 +196,10 @@ part_base_canyon() {
 
 part_base_str2str() {
   local dir="${work}/base-str2str"
-  rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}" || return
+  if ! { rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}"; }; then
+    fail base-str2str "cannot make ${dir}"
+    return
+  fi
   "${canyon}" convert -q --from rinex "${inst_base}" --nav "${inst_nav}" --out base.rtcm3 > convert.log 2>&1 ||
     { fail base-str2str "canyon convert (${dir}/convert.log)" && return; }
   local tcp_port ntrip_port
@@ -227,7 +234,10 @@ part_base_str2str() {
 
 part_ubx() {
   local dir="${work}/ubx"
-  rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}" || return
+  if ! { rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}"; }; then
+    fail ubx "cannot make ${dir}"
+    return
+  fi
   local base_pos
   base_pos="$(header_position "${m8p_base}")"
   "${canyon}" convert -q "${m8p_rover_ubx}" --obs-out rover.obs --nav-out rover.nav > convert.log 2>&1 ||
@@ -352,7 +362,10 @@ expect() {
 
 part_bad() {
   local dir="${work}/bad"
-  rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}" || return
+  if ! { rm -rf "${dir}" && mkdir -p "${dir}" && cd "${dir}"; }; then
+    fail bad "cannot make ${dir}"
+    return
+  fi
   local base_pos start code port
   base_pos="$(header_position "${m8p_base}")"
   local est="  mode: rtk

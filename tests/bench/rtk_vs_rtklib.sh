@@ -18,13 +18,14 @@
 #     ratio_threshold: 3.0                                    <- pos2-arthres
 #     glonass_ar: off | on                                    <- pos2-gloarmode
 #     troposphere: saastamoinen | off                         <- pos1-tropopt (with spp models off likewise)
-# (keys as in config/rtk.yaml; the other options keep their defaults there). If canyon rejects `--mode rtk`, the
-# script says so, still prints RTKLIB's side, and exits 0.
+# (keys as in config/rtk.yaml; the other options keep their defaults there). A failing canyon or rnx2rtkp run is a
+# row marked "fail" (the others still run) and makes the exit status 1.
 #
 # Usage: tests/bench/rtk_vs_rtklib.sh [BUILD_DIR] [RUNS]     (defaults: build, 5 timed runs of each program)
 # Environment: CANYON_SHARED_DATA_DIR (default ../shared/data), KEEP=1 keeps the temp folder and prints its path,
 # ONLY=REGEX runs only the rows whose dataset name matches (e.g. ONLY=cssrlib-kinematic for the speed target).
-# Exit status: 0 done (also when canyon's rtk mode is not available), 2 missing build or tools.
+# Exit status: 0 done, 1 a canyon or rnx2rtkp run failed, 2 missing build or tools, 77 (with a SKIP: line) a dataset
+# (or the whole shared data folder) missing and nothing failed.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -37,7 +38,7 @@ eval_pos=$build/tests/bench/bench_eval_pos
 [[ -x $canyon ]] || { echo "error: $canyon not built (run scripts/build.sh)" >&2; exit 2; }
 [[ -x $eval_pos ]] || { echo "error: $eval_pos not built (CANYON_BUILD_BENCHMARKS=ON)" >&2; exit 2; }
 command -v rnx2rtkp >/dev/null || { echo "error: rnx2rtkp not installed (run scripts/setup.sh)" >&2; exit 2; }
-[[ -d $data ]] || { echo "skipped: shared datasets not found at $data" >&2; exit 0; }
+[[ -d $data ]] || { echo "SKIP: shared datasets not found at $data"; exit 77; }
 data=$(cd "$data" && pwd)
 
 tmp=$(mktemp -d)
@@ -186,8 +187,8 @@ time_pair_ms() {
 # Value of key $2 in a bench_eval_pos --kv line $1, "-" if absent.
 kv() { tr ' ' '\n' <<<"$1" | awk -F= -v k="$2" '$1 == k {print $2; found = 1} END {if (!found) print "-"}'; }
 
-canyon_available=1
-canyon_message=""
+failures=()
+missing=()
 row() { printf '%-27s %-13s %8s %8s %9s %9s %6s %10s %10s %10s %7s\n' "$@"; }
 row dataset "AR mode" "c fix%" "R fix%" "c RMSE m" "R RMSE m" "c wrng" "max dfix m" "canyon ms" "RTKLIB ms" speedup
 for entry in "${runs_table[@]}"; do
@@ -197,7 +198,8 @@ for entry in "${runs_table[@]}"; do
   dir=$data/$(dataset_dir "$name")
   conf=$dir/rtklib/$conf_name
   if [[ ! -f $conf || ! -f $dir/$rover || ! -f $dir/$base ]]; then
-    echo "$name $conf_name: files missing, skipped"
+    echo "$name $conf_name: files missing, not run"
+    missing+=("$name $conf_name")
     continue
   fi
   work=$tmp/$name-${conf_name%.conf}
@@ -212,35 +214,36 @@ for entry in "${runs_table[@]}"; do
   [[ $truth == - ]] || truth_args=(--truth "$truth")
 
   rtklib_cmd=(rnx2rtkp -k "$work/rtklib.conf" -o "$work/rtklib.pos" "$dir/$rover" "$dir/$base" "${navs_abs[@]}")
-  "${rtklib_cmd[@]}" >/dev/null 2>&1 || { echo "$name $conf_name: rnx2rtkp failed" >&2; continue; }
+  if ! "${rtklib_cmd[@]}" >"$work/rtklib.log" 2>&1; then
+    echo "$name $conf_name: rnx2rtkp failed, see $work/rtklib.log" >&2
+    failures+=("$name $conf_name: rnx2rtkp")
+    row "$name" "$armode" fail fail
+    continue
+  fi
   rtklib_ms=-
   rtklib_kv=$("$eval_pos" "$work/rtklib.pos" "${truth_args[@]}" --epochs-in "$epochs_in" --kv)
 
   canyon_fix="-" canyon_rmse="-" canyon_wrong="-" max_dfix="-" canyon_ms="-" speedup="-"
-  if ((canyon_available)); then
-    base_pos=$(base_position "$conf" "$dir/$base")
-    canyon_cmd=("$canyon" process -q --mode rtk --config "$work/canyon.yaml" --rover "$dir/$rover" --base "$dir/$base")
-    for n in "${navs_abs[@]}"; do canyon_cmd+=(--nav "$n"); done
-    canyon_cmd+=(--base-pos "$base_pos" --out "$work/canyon.pos")
-    set +e
-    "${canyon_cmd[@]}" >"$work/canyon.log" 2>&1
-    rc=$?
-    set -e
-    if ((rc != 0)) && ((rc == 2)) && grep -qiE 'rtk|base|mode' "$work/canyon.log"; then
-      canyon_available=0
-      canyon_message="canyon rtk mode not available yet: \`canyon process --mode rtk\` was rejected ($(head -n 1 "$work/canyon.log"))"
-    elif ((rc != 0)); then
-      canyon_fix="fail"
-      echo "$name $conf_name: canyon failed (exit $rc), see $work/canyon.log" >&2
-    else
-      read -r rtklib_ms canyon_ms < <(time_pair_ms "${rtklib_cmd[@]}" -- "${canyon_cmd[@]}")
-      canyon_kv=$("$eval_pos" "$work/canyon.pos" "${truth_args[@]}" --epochs-in "$epochs_in" --ref "$work/rtklib.pos" --kv)
-      canyon_fix=$(kv "$canyon_kv" fixed_pct)
-      canyon_rmse=$(kv "$canyon_kv" rmse_3d_m)
-      canyon_wrong=$(kv "$canyon_kv" wrong_fixes)
-      max_dfix=$(kv "$canyon_kv" max_fixed_dist_m)
-      speedup=$(awk -v c="$canyon_ms" -v r="$rtklib_ms" 'BEGIN {if (c > 0) printf "%.1fx", r / c; else print "-"}')
-    fi
+  base_pos=$(base_position "$conf" "$dir/$base")
+  canyon_cmd=("$canyon" process -q --mode rtk --config "$work/canyon.yaml" --rover "$dir/$rover" --base "$dir/$base")
+  for n in "${navs_abs[@]}"; do canyon_cmd+=(--nav "$n"); done
+  canyon_cmd+=(--base-pos "$base_pos" --out "$work/canyon.pos")
+  set +e
+  "${canyon_cmd[@]}" >"$work/canyon.log" 2>&1
+  rc=$?
+  set -e
+  if ((rc != 0)); then
+    canyon_fix="fail"
+    echo "$name $conf_name: canyon failed (exit $rc), see $work/canyon.log" >&2
+    failures+=("$name $conf_name: canyon exit $rc")
+  else
+    read -r rtklib_ms canyon_ms < <(time_pair_ms "${rtklib_cmd[@]}" -- "${canyon_cmd[@]}")
+    canyon_kv=$("$eval_pos" "$work/canyon.pos" "${truth_args[@]}" --epochs-in "$epochs_in" --ref "$work/rtklib.pos" --kv)
+    canyon_fix=$(kv "$canyon_kv" fixed_pct)
+    canyon_rmse=$(kv "$canyon_kv" rmse_3d_m)
+    canyon_wrong=$(kv "$canyon_kv" wrong_fixes)
+    max_dfix=$(kv "$canyon_kv" max_fixed_dist_m)
+    speedup=$(awk -v c="$canyon_ms" -v r="$rtklib_ms" 'BEGIN {if (c > 0) printf "%.1fx", r / c; else print "-"}')
   fi
   [[ $rtklib_ms != - ]] || rtklib_ms=$(time_ms "${rtklib_cmd[@]}")
   row "$name" "$armode" "$canyon_fix" "$(kv "$rtklib_kv" fixed_pct)" "$canyon_rmse" \
@@ -249,5 +252,12 @@ done
 echo "fix% = fixed epochs / rover epochs; RMSE = 3D RMSE of all solutions vs truth (- : no truth); c wrng = canyon's"
 echo "fixed epochs more than 0.10 m from the truth; max dfix = largest canyon-RTKLIB distance on epochs both fixed;"
 echo "times = whole-process wall time, median of $runs runs, canyon and RTKLIB in turn."
-[[ -z $canyon_message ]] || echo "$canyon_message"
+if ((${#failures[@]} > 0)); then
+  printf 'FAILED: %s\n' "${failures[@]}"
+  exit 1
+fi
+if ((${#missing[@]} > 0)); then
+  echo "SKIP: rows not run, their files missing in $data: $(printf '%s; ' "${missing[@]}")"
+  exit 77
+fi
 exit 0

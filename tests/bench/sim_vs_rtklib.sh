@@ -11,7 +11,8 @@
 # Usage: tests/bench/sim_vs_rtklib.sh [BUILD_DIR] [SEEDS] [SCENARIOS...]
 #   defaults: build, "1", open-sky light-blocked urban-moderate urban-severe
 # Environment: KEEP=1 keeps the temp folder and prints its path.
-# Exit status: 0 done, 2 missing build or tools.
+# Exit status: 0 done, 1 a canyon process run failed (its cell says "failed", the other runs go on; listed at the
+# end), 2 missing build or tools.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -48,6 +49,7 @@ score() {
 
 printf '%-15s %4s %6s %6s | %-28s | %-28s | %-28s | %-28s\n' scenario seed gen_s nlos% \
   "RTKLIB est-stec fix/rmse/max" "RTKLIB brdc fix/rmse/max" "canyon rtk-urban fix/rmse/max" "canyon rtk.yaml fix/rmse/max"
+failed=()
 for scenario in "${scenarios[@]}"; do
   for seed in $seeds; do
     dir=$tmp/$scenario-$seed
@@ -59,9 +61,11 @@ for scenario in "${scenarios[@]}"; do
     rnx2rtkp -k "$tmp/rtklib-brdc.conf" -o "$dir/rtklib-brdc.pos" "$dir/rover.obs" "$dir/base.obs" "$dir/nav.rnx" \
       >/dev/null 2>&1
     "$canyon" process -q --mode rtk --config "$root/config/rtk-urban.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
-      --nav "$dir/nav.rnx" --out "$dir/canyon.pos" >/dev/null 2>&1 || true
+      --nav "$dir/nav.rnx" --out "$dir/canyon.pos" >"$dir/canyon.log" 2>&1 ||
+      failed+=("$scenario seed $seed: canyon rtk-urban ($(tail -n 1 "$dir/canyon.log"))")
     "$canyon" process -q --mode rtk --config "$root/config/rtk.yaml" --rover "$dir/rover.obs" --base "$dir/base.obs" \
-      --nav "$dir/nav.rnx" --out "$dir/canyon-default.pos" >/dev/null 2>&1 || true
+      --nav "$dir/nav.rnx" --out "$dir/canyon-default.pos" >"$dir/canyon-default.log" 2>&1 ||
+      failed+=("$scenario seed $seed: canyon rtk.yaml ($(tail -n 1 "$dir/canyon-default.log"))")
     cells=()
     for pos in rtklib rtklib-brdc canyon canyon-default; do
       if [[ -s $dir/$pos.pos ]]; then
@@ -76,3 +80,7 @@ for scenario in "${scenarios[@]}"; do
 done
 echo "fix = fixed epochs / rover epochs; rmse, max = 3D error of all solved epochs against truth.csv; w = wrong fixes"
 echo "(fixed, 3D error > 0.10 m); gen_s = wall time of canyon simulate; nlos% = rover signals received only by reflection."
+if ((${#failed[@]} > 0)); then
+  printf 'FAILED: %s\n' "${failed[@]}"
+  exit 1
+fi

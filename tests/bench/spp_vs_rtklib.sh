@@ -7,7 +7,9 @@
 # batches interleaved so that both see the same machine load.
 #
 # Usage: tests/bench/spp_vs_rtklib.sh [BUILD_DIR] [RUNS]      (defaults: build, 11 batches of BATCH=5 runs)
-# Exit status: 0 if canyon is at least MIN_SPEEDUP (default 5) times faster on every dataset, else 1.
+# Exit status: 0 if canyon is at least MIN_SPEEDUP (default 5) times faster on every dataset, else 1 (also when a
+# canyon or rnx2rtkp run fails: each is run once, checked, before the timed runs); 2 missing build or tools; 77 (with
+# a SKIP: line) a dataset (or the whole shared data folder) missing and nothing failed.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -19,7 +21,7 @@ canyon=$build/canyon
 
 [[ -x $canyon ]] || { echo "error: $canyon not built (run scripts/build.sh)" >&2; exit 2; }
 command -v rnx2rtkp >/dev/null || { echo "error: rnx2rtkp not installed (run scripts/setup.sh)" >&2; exit 2; }
-[[ -d $data ]] || { echo "skipped: shared datasets not found at $data" >&2; exit 0; }
+[[ -d $data ]] || { echo "SKIP: shared datasets not found at $data"; exit 77; }
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -47,10 +49,15 @@ median() { sort -n | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[
 
 printf '%-26s %7s %12s %12s %9s\n' dataset epochs "canyon ms" "RTKLIB ms" speedup
 status=0
+missing=()
 for entry in "${datasets[@]}"; do
   IFS='|' read -r name systems rover navs <<<"$entry"
   IFS='|' read -r -a nav_files <<<"$navs"
-  [[ -f $data/$rover ]] || { echo "$name: missing, skipped"; continue; }
+  if [[ ! -f $data/$rover ]]; then
+    echo "$name: $data/$rover missing, not run"
+    missing+=("$name")
+    continue
+  fi
   letters=${systems//,/, }
   cat >"$tmp/$name.yaml" <<YAML
 mode: spp
@@ -72,6 +79,17 @@ YAML
     canyon_args+=(--nav "$data/$n")
     rtklib_args+=("$data/$n")
   done
+  # One checked run of each first: the timed runs discard the exit status (a failing program would time as fast).
+  if ! "$canyon" "${canyon_args[@]}" >"$tmp/canyon.log" 2>&1; then
+    echo "$name: canyon failed: $(tail -n 1 "$tmp/canyon.log")"
+    status=1
+    continue
+  fi
+  if ! rnx2rtkp "${rtklib_args[@]}" >"$tmp/rtklib.log" 2>&1; then
+    echo "$name: rnx2rtkp failed: $(tail -n 1 "$tmp/rtklib.log")"
+    status=1
+    continue
+  fi
   : >"$tmp/c" ; : >"$tmp/r"
   for ((i = 0; i < runs; i++)); do
     elapsed "$canyon" "${canyon_args[@]}" >>"$tmp/c"
@@ -87,4 +105,8 @@ YAML
 done
 [[ $status -eq 0 ]] && echo "canyon SPP is at least ${min_speedup}x faster than RTKLIB rnx2rtkp single-point on every dataset" ||
   echo "canyon SPP is NOT ${min_speedup}x faster than RTKLIB rnx2rtkp single-point on every dataset"
+if ((status == 0 && ${#missing[@]} > 0)); then
+  echo "SKIP: datasets not run, their files missing in $data: ${missing[*]}"
+  exit 77
+fi
 exit $status

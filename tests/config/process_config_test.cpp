@@ -1,10 +1,16 @@
 #include "canyon/config/process_config.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "canyon/config/base_config.hpp"
+#include "canyon/config/rover_config.hpp"
 #include "canyon/core/constants.hpp"
 
 namespace canyon::config {
@@ -16,18 +22,57 @@ Result<ProcessConfig> parse(const std::string& text) {
   return parse_process_config(YAML::Load(text), "test.yaml");
 }
 
+// Every YAML file in config/ (what a user runs; scenarios/ has its own tests) is a process, rover or base
+// configuration that loads (rover and base ones also validate: their devices need not be there), and none is bound to
+// the developer's datasets: those live beside their tests, in tests/data/config/.
 TEST(ProcessConfigTest, EveryShippedConfigLoads) {
   const fs::path config_dir = fs::path(CANYON_SOURCE_DIR) / "config";
-  int loaded = 0;
+  int processes = 0;
+  std::vector<std::string> real_time;  // rover and base files
   for (const auto& entry : fs::directory_iterator(config_dir)) {
     if (entry.path().extension() != ".yaml") continue;
-    const YAML::Node node = YAML::LoadFile(entry.path().string());
-    if (!node["mode"]) continue;  // not a process configuration (scenarios etc. have their own tests)
-    auto config = load_process_config(entry.path().string());
-    ASSERT_TRUE(config.ok()) << config.error().to_string();
-    ++loaded;
+    const std::string path = entry.path().string();
+    SCOPED_TRACE(path);
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text.find("shared/data"), std::string::npos) << "dataset-bound: it belongs in tests/data/config/";
+    const YAML::Node node = YAML::LoadFile(path);
+    if (node["mode"]) {
+      auto config = load_process_config(path);
+      ASSERT_TRUE(config.ok()) << config.error().to_string();
+      ++processes;
+    } else if (node["estimator"]) {
+      auto config = load_rover_config(path);
+      ASSERT_TRUE(config.ok()) << config.error().to_string();
+      EXPECT_EQ(config->validate(), "");
+      real_time.push_back(entry.path().filename().string());
+    } else {  // anything else must be a base configuration (strict YAML: an unknown key is an error)
+      auto config = load_base_config(path);
+      ASSERT_TRUE(config.ok()) << config.error().to_string();
+      EXPECT_EQ(config->validate(), "");
+      real_time.push_back(entry.path().filename().string());
+    }
   }
-  EXPECT_GE(loaded, 2);
+  EXPECT_GE(processes, 4);  // spp, rtk, rtk-urban, fusion
+  std::sort(real_time.begin(), real_time.end());
+  EXPECT_EQ(real_time, (std::vector<std::string>{"base.yaml", "rover.yaml"}));
+}
+
+// tests/data/config/spp-cssrlib-kinematic.yaml, a job on the shared datasets: it loads and validates, and its
+// relative paths, resolved against its folder, name the dataset's files and the repository's out/.
+TEST(ProcessConfigTest, DatasetConfigLoadsAndNamesTheDatasetsFiles) {
+  auto config = load_process_config(std::string(CANYON_TEST_DATA_DIR) + "/config/spp-cssrlib-kinematic.yaml");
+  ASSERT_TRUE(config.ok()) << config.error().to_string();
+  EXPECT_EQ(config->mode, ProcessMode::Spp);
+  EXPECT_EQ(config->validate(), "");
+  EXPECT_EQ(fs::path(config->out).lexically_normal(),
+            (fs::path(CANYON_SOURCE_DIR) / "out/spp-cssrlib-kinematic.pos").lexically_normal());
+  const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "cssrlib-kinematic-doy265";
+  if (!fs::exists(data)) GTEST_SKIP() << "shared dataset not present: " << data << " (the paths were not checked)";
+  const auto same_file = [](const fs::path& a, const fs::path& b) { return fs::exists(a) && fs::equivalent(a, b); };
+  EXPECT_TRUE(same_file(config->rover_obs, data / "SEPT265G.21O")) << config->rover_obs;
+  ASSERT_EQ(config->nav.size(), 1U);
+  EXPECT_TRUE(same_file(config->nav[0], data / "SEPT2650.21P")) << config->nav[0];
 }
 
 TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {

@@ -1,8 +1,10 @@
-// config/rover.yaml loads, prints and reads back equal; typos and broken rules are errors naming the key.
+// config/rover.yaml (a u-blox receiver, the base over DDS) and tests/data/config/rover.yaml (a replay of the shared
+// datasets) load, print and read back equal; typos and broken rules are errors naming the key.
 
 #include "canyon/config/rover_config.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
@@ -11,15 +13,46 @@
 namespace canyon::config {
 namespace {
 
+// What a user runs: it loads and validates without the receiver being there.
 TEST(RoverConfig, ShippedFileLoadsAndRoundTrips) {
   auto config = load_rover_config(std::string(CANYON_SOURCE_DIR) + "/config/rover.yaml");
   ASSERT_TRUE(config) << config.error().to_string();
   EXPECT_EQ(config->validate(), "");
   EXPECT_EQ(config->estimator.mode, ProcessMode::Rtk);
+  EXPECT_EQ(config->rover, RoverInputKind::Ubx);
+  EXPECT_EQ(config->rover_source, "serial:///dev/ttyACM0?baud=115200");
+  EXPECT_EQ(config->base, RoverBaseSource::Dds);
+  EXPECT_TRUE(config->stream_ephemerides);
+  EXPECT_TRUE(config->estimator.nav.empty());  // the ephemerides come from the streams
+  EXPECT_TRUE(config->estimator.rover_obs.empty());
+  EXPECT_TRUE(config->estimator.base_obs.empty());
   EXPECT_TRUE(config->pipeline.threaded);
   auto again = parse_rover_config(YAML::Load(to_yaml(*config)), "printed");
   ASSERT_TRUE(again) << again.error().to_string();
   EXPECT_TRUE(*again == *config);
+}
+
+// The replay of the shared datasets: its relative paths, resolved against its folder, name the dataset's files.
+TEST(RoverConfig, DatasetFileLoadsAndRoundTrips) {
+  auto config = load_rover_config(std::string(CANYON_TEST_DATA_DIR) + "/config/rover.yaml");
+  ASSERT_TRUE(config) << config.error().to_string();
+  EXPECT_EQ(config->validate(), "");
+  EXPECT_EQ(config->estimator.mode, ProcessMode::Rtk);
+  EXPECT_EQ(config->rover, RoverInputKind::Rinex);
+  EXPECT_EQ(config->base, RoverBaseSource::File);
+  auto again = parse_rover_config(YAML::Load(to_yaml(*config)), "printed");
+  ASSERT_TRUE(again) << again.error().to_string();
+  EXPECT_TRUE(*again == *config);
+  namespace fs = std::filesystem;
+  const fs::path data = fs::path(CANYON_SHARED_DATA_DIR) / "instinct-spirent-rtk-sim";
+  if (!fs::exists(data)) GTEST_SKIP() << "shared dataset not present: " << data << " (the paths were not checked)";
+  const auto same_file = [](const fs::path& a, const fs::path& b) { return fs::exists(a) && fs::equivalent(a, b); };
+  EXPECT_TRUE(same_file(config->estimator.rover_obs, data / "iono-Klob_tropo-Saast/Rover-dynamic_MO_Spirent.obs"))
+      << config->estimator.rover_obs;
+  EXPECT_TRUE(same_file(config->estimator.base_obs, data / "iono-Klob_tropo-Saast/Base-static_MO_Spirent.obs"))
+      << config->estimator.base_obs;
+  ASSERT_EQ(config->estimator.nav.size(), 1U);
+  EXPECT_TRUE(same_file(config->estimator.nav[0], data / "RINEX_GN_Spirent.23N")) << config->estimator.nav[0];
 }
 
 TEST(RoverConfig, TyposAndBrokenRulesAreErrors) {

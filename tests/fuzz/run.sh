@@ -6,8 +6,11 @@
 # run; the crashing input is left in WORK_DIR. The three run at the same time.
 #
 # Usage: tests/fuzz/run.sh SECONDS [WORK_DIR]      (default WORK_DIR: <repo>/build/fuzz)
-# Exit status: 0 clean, 1 a fuzzer found a problem or the build failed, 77 clang++-14 / libFuzzer not installed.
-# Seeds: RTCM 3 made by build/canyon from the shared datasets and slices of the u-blox logs when they are there.
+# Exit status: 0 clean, 1 a fuzzer found a problem, the build failed or a seed could not be made, 77 (with a SKIP:
+# line) clang++-14 / libFuzzer not installed, or the fuzzers ran clean without the real-data seeds (shared datasets or
+# BUILD/canyon missing).
+# Seeds: RTCM 3 made by BUILD/canyon from the shared datasets and slices of the u-blox logs.
+# Environment: CANYON_BUILD_DIR (default <repo>/build), CANYON_SHARED_DATA_DIR (default <repo>/../shared/data).
 set -euo pipefail
 
 if (($# < 1)); then
@@ -18,10 +21,11 @@ seconds="$1"
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 work="$(realpath -m "${2:-${repo_root}/build/fuzz}")"
 data="${CANYON_SHARED_DATA_DIR:-${repo_root}/../shared/data}"
+canyon="${CANYON_BUILD_DIR:-${repo_root}/build}/canyon"
 
 cxx="$(command -v clang++-14 || true)"
 if [[ -z "${cxx}" ]] || ! compgen -G "/usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a" > /dev/null; then
-  echo "fuzz: clang++-14 or libclang-rt-14-dev (libFuzzer) not installed: skipped (scripts/setup.sh installs them)"
+  echo "SKIP: clang++-14 or libclang-rt-14-dev (libFuzzer) not installed (scripts/setup.sh installs them)"
   exit 77
 fi
 
@@ -58,7 +62,8 @@ for t in "${targets[@]}"; do
   "${cxx}" "${flags[@]/fuzzer-no-link/fuzzer}" "${repo_root}/tests/fuzz/${t}.cpp" "${objects[@]}" -lz -o "${work}/${t}"
 done
 
-# Seed corpora (kept between runs; libFuzzer adds what it finds).
+# Seed corpora (kept between runs; libFuzzer adds what it finds). A corpus without its seed_* files gets them.
+no_seeds=() # what could not be seeded, and why
 seed() {
   local dir="$1" file="$2" piece="$3" count="$4"
   [[ -f "${file}" ]] || return 0
@@ -67,16 +72,34 @@ seed() {
   done
 }
 mkdir -p "${work}/corpus_rtcm3" "${work}/corpus_ubx" "${work}/corpus_ntrip"
-if [[ -z "$(ls -A "${work}/corpus_rtcm3")" && -x "${repo_root}/build/canyon" && -d "${data}" ]]; then
-  "${repo_root}/build/canyon" convert "${data}/matrtklib-static/base.obs" --nav "${data}/matrtklib-static/base.nav" \
-    --out "${work}/seed.rtcm3" -q > /dev/null 2>&1 || true
-  seed "${work}/corpus_rtcm3" "${work}/seed.rtcm3" 2048 32
+if ! compgen -G "${work}/corpus_rtcm3/seed_*" > /dev/null; then
+  if [[ ! -x "${canyon}" ]]; then
+    no_seeds+=("RTCM 3: ${canyon} not built")
+  elif [[ ! -f "${data}/matrtklib-static/base.obs" ]]; then
+    no_seeds+=("RTCM 3: shared dataset not found at ${data}/matrtklib-static")
+  else
+    if ! "${canyon}" convert "${data}/matrtklib-static/base.obs" --nav "${data}/matrtklib-static/base.nav" \
+      --out "${work}/seed.rtcm3" -q > "${work}/seed_rtcm3.log" 2>&1; then
+      echo "fuzz: error: the RTCM 3 seed: canyon convert failed (${work}/seed_rtcm3.log)"
+      exit 1
+    fi
+    seed "${work}/corpus_rtcm3" "${work}/seed.rtcm3" 2048 32
+  fi
 fi
-if [[ -z "$(ls -A "${work}/corpus_ubx")" && -d "${data}/m8p-galway-20181004" ]]; then
-  (zcat "${data}/m8p-galway-20181004/20181004_rover-20181004-1532.ubx.gz" | head -c 262144 > "${work}/seed_rover.ubx") || true
-  (zcat "${data}/m8p-galway-20181004/20181004_base-20181004-1452.ubx.gz" | head -c 262144 > "${work}/seed_base.ubx") || true
-  seed "${work}/corpus_ubx" "${work}/seed_rover.ubx" 4096 32
-  seed "${work}/corpus_ubx" "${work}/seed_base.ubx" 4096 32
+if ! compgen -G "${work}/corpus_ubx/seed_*" > /dev/null; then
+  if [[ ! -d "${data}/m8p-galway-20181004" ]]; then
+    no_seeds+=("UBX: shared dataset not found at ${data}/m8p-galway-20181004")
+  else
+    for log in rover-20181004-1532 base-20181004-1452; do
+      # The first 256 KiB of the log (head stops reading early: zcat's broken pipe is expected, hence no pipeline).
+      head -c 262144 < <(zcat "${data}/m8p-galway-20181004/20181004_${log}.ubx.gz") > "${work}/seed_${log%%-*}.ubx"
+      if (($(stat -c %s "${work}/seed_${log%%-*}.ubx") != 262144)); then
+        echo "fuzz: error: the UBX seed: cannot read 256 KiB of ${data}/m8p-galway-20181004/20181004_${log}.ubx.gz"
+        exit 1
+      fi
+      seed "${work}/corpus_ubx" "${work}/seed_${log%%-*}.ubx" 4096 32
+    done
+  fi
 fi
 if [[ -z "$(ls -A "${work}/corpus_ntrip")" ]]; then
   printf 'GET /CANYON HTTP/1.0\r\nUser-Agent: NTRIP RTKLIB/2.4.3\r\nAuthorization: Basic dXNlcjpwdw==\r\n\r\n' \
@@ -120,4 +143,8 @@ for i in "${!targets[@]}"; do
 done
 echo
 printf '%s\n' "${summary[@]}"
+if ((status == 0 && ${#no_seeds[@]} > 0)); then
+  echo "SKIP: fuzzed without the real-data seeds: $(printf '%s; ' "${no_seeds[@]}")"
+  exit 77
+fi
 exit "${status}"

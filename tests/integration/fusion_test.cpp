@@ -182,14 +182,16 @@ TEST(FusionCli, UrbanSevereSolvesEveryEpochWithoutWrongFixesAndBeatsRtklib) {
   EXPECT_DOUBLE_EQ(availability, 1.0);
   EXPECT_LE(wrong, std::max(0.0, 0.01 * fixed * 1501));
   EXPECT_LT(rmse, 15.0);  // metres: no fix survives the canyon, the VIO carries a float
-  if (rtklib) {
-    const double rtklib_rmse = json_number(json, "RTKLIB", "rmse_m");
-    std::printf("[ FUSION   ] RTKLIB on the same files: 3D RMSE %.2f m, availability %.1f %%\n", rtklib_rmse,
-                100.0 * json_number(json, "RTKLIB", "availability"));
-    // On this 5-minute clip at least half RTKLIB's RMSE; the issue asks 1/5, which the whole 10-minute runs of
-    // tests/bench/fusion_vs_rtklib.sh measure (README: met on some seeds only).
-    EXPECT_LE(rmse, rtklib_rmse / 2.0);
+  // The comparison needs RTKLIB: without it the checks above stand and the test says what it could not check.
+  if (!rtklib) {
+    GTEST_SKIP() << "RTKLIB rnx2rtkp not installed (scripts/setup.sh installs it): fusion not compared with RTKLIB";
   }
+  const double rtklib_rmse = json_number(json, "RTKLIB", "rmse_m");
+  std::printf("[ FUSION   ] RTKLIB on the same files: 3D RMSE %.2f m, availability %.1f %%\n", rtklib_rmse,
+              100.0 * json_number(json, "RTKLIB", "availability"));
+  // On this 5-minute clip at least half RTKLIB's RMSE; the issue asks 1/5, which the whole 10-minute runs of
+  // tests/bench/fusion_vs_rtklib.sh measure (README: met on some seeds only).
+  EXPECT_LE(rmse, rtklib_rmse / 2.0);
 }
 
 // --- Bad input ------------------------------------------------------------------------------------------------------

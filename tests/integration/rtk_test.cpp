@@ -3,6 +3,7 @@
 // for; the ones still open (QZSS never worse, m8p, speed) are reported by tests/bench/rtk_vs_rtklib.sh.
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -239,6 +240,7 @@ TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
     rtk::ArMode mode;
     const char* rtklib_pos;
   };
+  std::vector<std::string> unexplained;  // modes with epochs beyond kMaxDistanceToRtklibFixM and no RTKLIB to run
   for (const Case& k : {Case{rtk::ArMode::Continuous, "rtk_kinematic.pos"},
                         Case{rtk::ArMode::Instantaneous, "rtk_kinematic_inst.pos"}}) {
     auto run = run_rtk("kinematic", "cssrlib-kinematic-doy265/SEPT265G.21O", "cssrlib-kinematic-doy265/3034265G.21O",
@@ -272,7 +274,11 @@ TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
       }
     }
     EXPECT_LE(beyond.size(), 2U);
-    if (beyond.empty() || !test::have_rtklib()) continue;
+    if (beyond.empty()) continue;
+    if (!test::have_rtklib()) {  // the epochs beyond cannot be explained: said below, after the other cases
+      unexplained.push_back(rtk::ar_mode_name(k.mode));
+      continue;
+    }
     const fs::path dir = test::temp_dir("rtk") / "kinematic-without-g14";
     fs::create_directories(dir);
     const fs::path conf = dir / "rtklib.conf";
@@ -299,6 +305,12 @@ TEST(RtkRealData, CssrlibKinematicFixRateAtLeastRtklibs) {
                 << (c->p_E_m - test::nearest(*rtklib, t, 0.01)->p_E_m).norm() << " m, canyon - RTKLIB without G14 "
                 << (c->p_E_m - r14->p_E_m).norm() << " m\n";
     }
+  }
+  if (!unexplained.empty()) {
+    GTEST_SKIP() << "RTKLIB rnx2rtkp not installed (scripts/setup.sh installs it): the fixes more than "
+                 << std::lround(kMaxDistanceToRtklibFixM * 1000.0) << " mm from RTKLIB's (" << unexplained.front()
+                 << (unexplained.size() > 1 ? ", " + unexplained.back() : std::string()) << ") were not checked "
+                 << "against RTKLIB without G14";
   }
 }
 
