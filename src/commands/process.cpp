@@ -232,11 +232,11 @@ class FileEpochSource final : public pipeline::EpochSource {
  public:
   FileEpochSource(pipeline::ObservationStream& rover, pipeline::BaseCursor& base) : rover_(rover), base_(base) {}
 
-  Result<std::optional<pipeline::EpochItem>> next() override {
+  Result<std::optional<pipeline::IngestedEpoch>> next() override {
     auto next = rover_.next();
     if (!next) return next.error();
-    if (!*next) return std::optional<pipeline::EpochItem>{};
-    std::optional<pipeline::EpochItem> item(std::in_place);
+    if (!*next) return std::optional<pipeline::IngestedEpoch>{};
+    std::optional<pipeline::IngestedEpoch> item(std::in_place);
     item->rover = std::move(**next);
     auto base_epoch = base_.at(item->rover.time);
     if (!base_epoch) return base_epoch.error();
@@ -259,20 +259,21 @@ Status run_staged(pipeline::EpochEstimator& estimator, pipeline::ObservationStre
                   const pipeline::PipelineOptions& pipeline,
                   const std::function<void(const core::GpsTime&)>& on_epoch = {}) {
   FileEpochSource source(rover, base);
-  const auto sink = [&](const pipeline::EpochItem& item) -> Status {
-    if (on_epoch) on_epoch(item.rover.time);
+  const auto sink = [&](const pipeline::SolvedEpoch& solved) -> Status {
+    const core::GpsTime& t = solved.epoch().rover.time;
+    if (on_epoch) on_epoch(t);
     ++summary.epochs;
-    if (item.output) {
-      const pipeline::EpochOutput& out = *item.output;
+    if (solved.output) {
+      const pipeline::EpochOutput& out = *solved.output;
       if (Status w = writer.write(out.solution, out.hdop); !w) return w.error();
       ++summary.solved;
       if (out.solution.status == core::SolutionStatus::Fixed) {
         ++summary.fixed;
       } else {
-        add_epoch_note(summary, item.rover.time, status_word(out.solution.status), out.note);
+        add_epoch_note(summary, t, status_word(out.solution.status), out.note);
       }
-    } else if (item.error) {
-      add_epoch_note(summary, item.rover.time, "no solution", item.error->message);
+    } else {
+      add_epoch_note(summary, t, "no solution", solved.output.error().message);
     }
     if (progress) progress(summary.epochs, source.fraction_read());
     return Ok{};

@@ -41,15 +41,15 @@ Eigen::Matrix3d from_upper(const std::array<double, 6>& u) {
 
 }  // namespace
 
-msg::StageStamps to_msg_stamps(const pipeline::EpochItem& item) {
+msg::StageStamps to_msg_stamps(const pipeline::IngestedEpoch& item) {
   msg::StageStamps s;
   s.arrival_monotonic_ns(item.arrival_ns);
   s.base_send_monotonic_ns(item.base_send_ns);
   std::array<std::int64_t, 6> enter{};
   std::array<std::int64_t, 6> exit{};
   for (std::size_t i = 0; i < pipeline::kNumStages; ++i) {
-    enter[i] = item.enter_ns[i];
-    exit[i] = item.exit_ns[i];
+    enter[i] = item.clock.enter_ns[i];
+    exit[i] = item.clock.exit_ns[i];
   }
   s.enter_monotonic_ns(enter);
   s.exit_monotonic_ns(exit);
@@ -60,7 +60,7 @@ namespace {
 
 /// A message about `item`'s epoch with its sequence number and the rover epoch's GPST set.
 template <typename Msg>
-Msg epoch_message(const pipeline::EpochItem& item) {
+Msg epoch_message(const pipeline::IngestedEpoch& item) {
   Msg m;
   m.sequence_number(item.seq);
   m.gps_week(item.rover.time.week);
@@ -70,15 +70,16 @@ Msg epoch_message(const pipeline::EpochItem& item) {
 
 }  // namespace
 
-msg::Solution to_msg_solution(const pipeline::EpochItem& item, const EpochContext& context) {
+msg::Solution to_msg_solution(const pipeline::SolvedEpoch& solved, const EpochContext& context) {
+  const pipeline::IngestedEpoch& item = solved.epoch();
   msg::Solution m;
   m.sequence_number(item.seq);
   m.rover_id(context.rover_id);
-  const core::GpsTime t = item.output ? item.output->solution.time : item.rover.time;
+  const core::GpsTime t = solved.output ? solved.output->solution.time : item.rover.time;
   m.gps_week(t.week);
   m.gps_tow_s(t.tow_s);
-  if (item.output) {
-    const pipeline::EpochOutput& o = *item.output;
+  if (solved.output) {
+    const pipeline::EpochOutput& o = *solved.output;
     const core::Solution& s = o.solution;
     m.status(static_cast<std::uint8_t>(s.status));
     m.p_E_m({s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z()});
@@ -98,13 +99,14 @@ msg::Solution to_msg_solution(const pipeline::EpochItem& item, const EpochContex
     m.note(o.note.substr(0, kMaxNote));
   } else {
     m.status(0);
-    m.note(item.error ? item.error->message.substr(0, kMaxNote) : std::string("no solution"));
+    m.note(solved.output.error().message.substr(0, kMaxNote));
   }
   m.stamps(to_msg_stamps(item));
   return m;
 }
 
-msg::StageTiming to_msg_timing(const pipeline::EpochItem& item, const EpochContext& context) {
+msg::StageTiming to_msg_timing(const pipeline::SolvedEpoch& solved, const EpochContext& context) {
+  const pipeline::IngestedEpoch& item = solved.epoch();
   auto m = epoch_message<msg::StageTiming>(item);
   m.rover_id(context.rover_id);
   m.stamps(to_msg_stamps(item));
@@ -133,13 +135,14 @@ msg::StageTiming to_msg_timing(const pipeline::EpochItem& item, const EpochConte
   return m;
 }
 
-msg::BridgedEpoch to_msg_bridged(const pipeline::EpochItem& item) {
+msg::BridgedEpoch to_msg_bridged(const pipeline::SolvedEpoch& solved) {
+  const pipeline::IngestedEpoch& item = solved.epoch();
   auto m = epoch_message<msg::BridgedEpoch>(item);
-  m.valid(item.pose.has_value());
-  if (item.pose) {
-    m.vio_segment(item.pose->segment);
-    const Eigen::Vector3d& p = item.pose->T_OI.p;
-    const Eigen::Quaterniond& q = item.pose->T_OI.q;
+  m.valid(solved.pose().has_value());
+  if (solved.pose()) {
+    m.vio_segment(solved.pose()->segment);
+    const Eigen::Vector3d& p = solved.pose()->T_OI.p;
+    const Eigen::Quaterniond& q = solved.pose()->T_OI.q;
     m.p_O_m({p.x(), p.y(), p.z()});
     m.q_OI_xyzw({q.x(), q.y(), q.z(), q.w()});
   }
@@ -147,10 +150,11 @@ msg::BridgedEpoch to_msg_bridged(const pipeline::EpochItem& item) {
   return m;
 }
 
-msg::Prior to_msg_prior(const pipeline::EpochItem& item) {
+msg::Prior to_msg_prior(const pipeline::SolvedEpoch& solved) {
+  const pipeline::IngestedEpoch& item = solved.epoch();
   auto m = epoch_message<msg::Prior>(item);
-  if (item.output && item.output->has_prior) {
-    const pipeline::EpochOutput& o = *item.output;
+  if (solved.output && solved.output->has_prior) {
+    const pipeline::EpochOutput& o = *solved.output;
     m.aided(true);
     m.p_E_m({o.prior_p_E_m.x(), o.prior_p_E_m.y(), o.prior_p_E_m.z()});
     m.covariance_E_m2(upper(o.prior_P_E_m2));
@@ -159,10 +163,11 @@ msg::Prior to_msg_prior(const pipeline::EpochItem& item) {
   return m;
 }
 
-msg::FloatSolution to_msg_float(const pipeline::EpochItem& item) {
+msg::FloatSolution to_msg_float(const pipeline::SolvedEpoch& solved) {
+  const pipeline::IngestedEpoch& item = solved.epoch();
   auto m = epoch_message<msg::FloatSolution>(item);
-  if (item.output && item.output->has_float) {
-    const pipeline::EpochOutput& o = *item.output;
+  if (solved.output && solved.output->has_float) {
+    const pipeline::EpochOutput& o = *solved.output;
     m.valid(true);
     m.p_E_m({o.float_p_E_m.x(), o.float_p_E_m.y(), o.float_p_E_m.z()});
     m.covariance_E_m2(upper(o.float_P_E_m2));
@@ -175,11 +180,12 @@ msg::FloatSolution to_msg_float(const pipeline::EpochItem& item) {
   return m;
 }
 
-msg::Alignment to_msg_alignment(const pipeline::EpochItem& item) {
+msg::Alignment to_msg_alignment(const pipeline::SolvedEpoch& solved) {
+  const pipeline::IngestedEpoch& item = solved.epoch();
   auto m = epoch_message<msg::Alignment>(item);
   m.kind("none");
-  if (item.output && item.output->alignment) {
-    const pipeline::EpochOutput::Alignment& a = *item.output->alignment;
+  if (solved.output && solved.output->alignment) {
+    const pipeline::EpochOutput::Alignment& a = *solved.output->alignment;
     m.aligned(true);
     m.kind(a.kind.substr(0, 15));
     m.rmse_m(a.rmse_m);

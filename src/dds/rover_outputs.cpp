@@ -49,17 +49,17 @@ void RoverOutputs::set_sources(const pipeline::RoverIngest& source, const pipeli
 }
 
 pipeline::EpochSink RoverOutputs::sink() {
-  return [this](const pipeline::EpochItem& item) { return write_epoch(item); };
+  return [this](const pipeline::SolvedEpoch& solved) { return write_epoch(solved); };
 }
 
 pipeline::StageObserver RoverOutputs::observer() {
   pipeline::StageObserver observer;
-  observer.taken = [this](pipeline::Stage stage, const pipeline::EpochItem& item) { taken(stage, item); };
+  observer.solved = [this](const pipeline::SolvedEpoch& solved) { take_solved(solved); };
   observer.handed_on = [this](pipeline::Stage stage) { handed_on(stage); };
   return observer;
 }
 
-Status RoverOutputs::write_epoch(const pipeline::EpochItem& item) {
+Status RoverOutputs::write_epoch(const pipeline::SolvedEpoch& item) {
   ++epochs_;
   if (item.output) {
     ++solved_;
@@ -70,7 +70,7 @@ Status RoverOutputs::write_epoch(const pipeline::EpochItem& item) {
   return Ok{};
 }
 
-void RoverOutputs::update_context(const pipeline::EpochItem& item) {
+void RoverOutputs::update_context(const pipeline::SolvedEpoch& item) {
   context_.rover_id = rover_id_;
   if (source_ != nullptr) context_.base_late = source_->base_late();
   context_.malformed_samples = malformed_payloads();
@@ -91,8 +91,7 @@ void RoverOutputs::update_context(const pipeline::EpochItem& item) {
   }
 }
 
-void RoverOutputs::taken(pipeline::Stage stage, const pipeline::EpochItem& item) {
-  if (stage != pipeline::Stage::Ambiguity) return;
+void RoverOutputs::take_solved(const pipeline::SolvedEpoch& item) {
   update_context(item);
   auto solution = to_msg_solution(item, context_);
   if (!solution_->write(solution)) refused_.fetch_add(1);

@@ -20,7 +20,7 @@ namespace canyon::pipeline {
 namespace {
 
 /// The output fields both engines' epochs have (rtk::RtkEpoch, fusion::FusionEpoch), with the RTK filter's figures
-/// from `filter` (rtk mode: the epoch itself; fusion: its RTK engine's epoch, FusionEpoch::rtk).
+/// from `filter` (rtk mode: the epoch itself; fusion: its RTK filter's epoch, FusionEpoch::rtk).
 template <typename Epoch>
 EpochOutput output_of(Epoch& epoch, const rtk::RtkEpoch& filter) {
   EpochOutput out;
@@ -41,13 +41,9 @@ EpochOutput output_of(Epoch& epoch, const rtk::RtkEpoch& filter) {
   return out;
 }
 
-/// The prediction stage's verdict (either engine's predict()) into the epoch.
-void record_prediction(EpochItem& item, const Result<bool>& more) {
-  if (more) {
-    item.to_update = *more;
-  } else {
-    item.error = more.error();
-  }
+/// The prediction's verdict: go on to the update.
+bool goes_on(const PredictedEpoch& epoch) {
+  return epoch.verdict && *epoch.verdict;
 }
 
 }  // namespace
@@ -70,61 +66,79 @@ std::int64_t monotonic_ns() {
 
 // ---- Estimators: the engines' stages ----
 
-void RtkEstimator::bridge(EpochItem& item) const {
-  if (item.base_position_E_m) geometry_.set_base_position(*item.base_position_E_m);
-  item.geometry.emplace(geometry_.build(item.rover, item.base ? &*item.base : nullptr));
+BridgedEpoch RtkEstimator::bridge(IngestedEpoch epoch) const {
+  if (epoch.base_position_E_m) geometry_.set_base_position(*epoch.base_position_E_m);
+  rtk::EpochGeometry geometry = geometry_.build(epoch.rover, epoch.base_epoch());
+  return BridgedEpoch{std::move(epoch), fusion::FusionGeometry{std::move(geometry), std::nullopt, 0}, std::nullopt};
 }
 
-void RtkEstimator::predict(EpochItem& item) {
-  if (item.base_position_E_m) engine_.set_base_position(*item.base_position_E_m);
-  const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
-  record_prediction(item, engine_.predict(item.rover, base, nullptr, item.geometry ? &*item.geometry : nullptr));
+PredictedEpoch RtkEstimator::predict(AlignedEpoch epoch) {
+  const IngestedEpoch& e = epoch.bridged.epoch;
+  if (e.base_position_E_m) engine_.set_base_position(*e.base_position_E_m);
+  Result<bool> verdict = engine_.predict(e.rover, e.base_epoch(), nullptr, &epoch.bridged.geometry.rtk);
+  return PredictedEpoch{std::move(epoch), std::move(verdict)};
 }
 
-void RtkEstimator::update(EpochItem& item) {
-  if (item.to_update) item.to_resolve = engine_.update();
+UpdatedEpoch RtkEstimator::update(PredictedEpoch epoch) {
+  const bool to_resolve = goes_on(epoch) && engine_.update();
+  return UpdatedEpoch{std::move(epoch), to_resolve};
 }
 
-void RtkEstimator::resolve(EpochItem& item) {
-  if (item.error) return;
-  if (item.to_resolve) engine_.resolve();
-  rtk::RtkEpoch epoch = engine_.take_epoch();
-  item.output = output_of(epoch, epoch);
+SolvedEpoch RtkEstimator::resolve(UpdatedEpoch epoch) {
+  SolvedEpoch solved{std::move(epoch)};
+  const Result<bool>& verdict = solved.updated.predicted.verdict;
+  if (!verdict) {
+    solved.output = verdict.error();
+    return solved;
+  }
+  if (solved.updated.to_resolve) engine_.resolve();
+  rtk::RtkEpoch result = engine_.take_epoch();
+  solved.output = output_of(result, result);
+  return solved;
 }
 
-void FusionEstimator::bridge(EpochItem& item) const {
-  if (item.base_position_E_m) geometry_.set_base_position(*item.base_position_E_m);
-  item.fusion_geometry.emplace(geometry_.build(item.rover, item.base ? &*item.base : nullptr));
-  if (live_vio_ != nullptr) live_vio_->await(item.rover.time);
-  item.pose = engine_.bridge(item.rover.time);
+BridgedEpoch FusionEstimator::bridge(IngestedEpoch epoch) const {
+  if (epoch.base_position_E_m) geometry_.set_base_position(*epoch.base_position_E_m);
+  fusion::FusionGeometry geometry = geometry_.build(epoch.rover, epoch.base_epoch());
+  if (live_vio_ != nullptr) live_vio_->await(epoch.rover.time);
+  std::optional<fusion::VioPoseAt> pose = engine_.bridge(epoch.rover.time);
+  return BridgedEpoch{std::move(epoch), std::move(geometry), std::move(pose)};
 }
 
-void FusionEstimator::align(EpochItem& item) {
-  engine_.align(item.rover.time, item.pose);
+AlignedEpoch FusionEstimator::align(BridgedEpoch epoch) {
+  engine_.align(epoch.epoch.rover.time, epoch.pose);
+  return AlignedEpoch{std::move(epoch)};
 }
 
-void FusionEstimator::predict(EpochItem& item) {
-  if (item.base_position_E_m) engine_.set_base_position(*item.base_position_E_m);
-  const core::ObsEpoch* base = item.base ? &*item.base : nullptr;
-  record_prediction(
-      item, engine_.predict(item.rover, base, item.pose, item.fusion_geometry ? &*item.fusion_geometry : nullptr));
+PredictedEpoch FusionEstimator::predict(AlignedEpoch epoch) {
+  BridgedEpoch& b = epoch.bridged;
+  if (b.epoch.base_position_E_m) engine_.set_base_position(*b.epoch.base_position_E_m);
+  Result<bool> verdict = engine_.predict(b.epoch.rover, b.epoch.base_epoch(), b.pose, &b.geometry);
+  return PredictedEpoch{std::move(epoch), std::move(verdict)};
 }
 
-void FusionEstimator::update(EpochItem& item) {
-  if (item.to_update) item.to_resolve = engine_.update();
+UpdatedEpoch FusionEstimator::update(PredictedEpoch epoch) {
+  const bool to_resolve = goes_on(epoch) && engine_.update();
+  return UpdatedEpoch{std::move(epoch), to_resolve};
 }
 
-void FusionEstimator::resolve(EpochItem& item) {
-  if (item.error) return;
-  if (item.to_resolve) engine_.resolve();
-  fusion::FusionEpoch epoch = engine_.finish_epoch();
-  EpochOutput out = output_of(epoch, epoch.rtk);
-  out.aided = epoch.aided;
+SolvedEpoch FusionEstimator::resolve(UpdatedEpoch epoch) {
+  SolvedEpoch solved{std::move(epoch)};
+  const Result<bool>& verdict = solved.updated.predicted.verdict;
+  if (!verdict) {
+    solved.output = verdict.error();
+    return solved;
+  }
+  if (solved.updated.to_resolve) engine_.resolve();
+  fusion::FusionEpoch result = engine_.finish_epoch();
+  EpochOutput out = output_of(result, result.rtk);
+  out.aided = result.aided;
   if (!engine_.stats().alignment.events.empty()) {
     const fusion::AlignmentEvent& a = engine_.stats().alignment.events.back();
     out.alignment = EpochOutput::Alignment{a.kind, a.rmse_m, a.first_eigenvalue_ratio, engine_.lever_arm_m()};
   }
-  item.output = std::move(out);
+  solved.output = std::move(out);
+  return solved;
 }
 
 // ---- The pipeline ----
@@ -154,16 +168,18 @@ std::string PipelineOptions::unavailable_cpu() const {
   return {};
 }
 
-using ItemPtr = std::unique_ptr<EpochItem>;  // nullptr: end of the stream
 /// Epochs per hand-over in the bridge-ahead pipeline.
 constexpr std::size_t kBridgeAheadBatch = 4;
-using ItemQueue = core::SpscHandoff<ItemPtr>;
 
+/// The queues of the threaded layout: queue i joins stage i to stage i + 1 (nullopt: the end of the stream).
 struct EpochPipeline::Queues {
-  explicit Queues(std::size_t capacity) {
-    for (auto& q : between) q = std::make_unique<ItemQueue>(capacity);
-  }
-  std::array<std::unique_ptr<ItemQueue>, kNumStages - 1> between;  // stage i -> stage i + 1
+  explicit Queues(std::size_t capacity)
+      : ingested(capacity), bridged(capacity), aligned(capacity), predicted(capacity), updated(capacity) {}
+  core::SpscHandoff<std::optional<IngestedEpoch>> ingested;
+  core::SpscHandoff<std::optional<BridgedEpoch>> bridged;
+  core::SpscHandoff<std::optional<AlignedEpoch>> aligned;
+  core::SpscHandoff<std::optional<PredictedEpoch>> predicted;
+  core::SpscHandoff<std::optional<UpdatedEpoch>> updated;
   core::SpscHandoff<bool> tokens{2};  // ambiguity -> alignment: the estimator state is free for the next epoch
 };
 
@@ -189,10 +205,10 @@ void EpochPipeline::fail(const Error& error) {
 }
 
 std::array<std::size_t, kNumStages - 1> EpochPipeline::queue_depths() const {
-  std::array<std::size_t, kNumStages - 1> depths{};
-  if (!queues_) return depths;
-  for (std::size_t i = 0; i < depths.size(); ++i) depths[i] = queues_->between[i]->size_approx();
-  return depths;
+  if (!queues_) return {};
+  const Queues& q = *queues_;
+  return {q.ingested.size_approx(), q.bridged.size_approx(), q.aligned.size_approx(), q.predicted.size_approx(),
+          q.updated.size_approx()};
 }
 
 PipelineStats EpochPipeline::stats() const {
@@ -200,27 +216,6 @@ PipelineStats EpochPipeline::stats() const {
   s.epochs = epochs_.load();
   for (std::size_t i = 0; i < s.full_waits.size(); ++i) s.full_waits[i] = full_waits_[i].load();
   return s;
-}
-
-/// One stage (not ingest) on one epoch, with its enter and exit times.
-void EpochPipeline::run_stage(Stage stage, EpochItem& item) {
-  const auto i = static_cast<std::size_t>(stage);
-  item.enter_ns[i] = monotonic_ns();
-  switch (stage) {
-    case Stage::Ingest: break;
-    case Stage::TimeBridge:
-      if (item.navigation) add_navigation(item);
-      estimator_.bridge(item);
-      break;
-    case Stage::Alignment: estimator_.align(item); break;
-    case Stage::Prediction: estimator_.predict(item); break;
-    case Stage::Update:
-      if (!item.error) estimator_.update(item);
-      break;
-    case Stage::Ambiguity: estimator_.resolve(item); break;
-  }
-  item.exit_ns[i] = monotonic_ns();
-  if (observer_.taken) observer_.taken(stage, item);
 }
 
 Status EpochPipeline::run() {
@@ -232,32 +227,82 @@ Status EpochPipeline::run() {
   return Ok{};
 }
 
-void EpochPipeline::ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns) {
-  item.seq = seq;
-  if (item.arrival_ns == 0) item.arrival_ns = enter_ns;
-  item.enter_ns[0] = item.arrival_ns;
-  item.exit_ns[0] = monotonic_ns();
-  if (observer_.taken) observer_.taken(Stage::Ingest, item);
+// ---- The stages ----
+
+void EpochPipeline::ingested(IngestedEpoch& epoch, std::uint64_t seq, std::int64_t enter_ns) {
+  epoch.seq = seq;
+  if (epoch.arrival_ns == 0) epoch.arrival_ns = enter_ns;
+  epoch.clock.enter_ns[0] = epoch.arrival_ns;
+  epoch.clock.exit_ns[0] = monotonic_ns();
+  if (observer_.taken) observer_.taken(Stage::Ingest, epoch);
 }
 
-std::unique_ptr<EpochItem> EpochPipeline::ingest_next(std::uint64_t seq) {
+std::optional<IngestedEpoch> EpochPipeline::ingest_next(std::uint64_t seq) {
   const std::int64_t enter = monotonic_ns();
   auto next = source_.next();
   if (!next) {
     fail(next.error());
-    return nullptr;
+    return std::nullopt;
   }
-  if (!*next) return nullptr;
-  auto item = std::make_unique<EpochItem>(std::move(**next));
-  ingested(*item, seq, enter);
-  return item;
+  if (!*next) return std::nullopt;
+  ingested(**next, seq, enter);
+  return std::move(*next);
 }
 
-void EpochPipeline::add_navigation(const EpochItem& item) {
-  // Every earlier epoch has left the last stage (sequential: always so), then no stage reads the ephemerides.
-  while (epochs_.load() < item.seq) std::this_thread::sleep_for(std::chrono::microseconds(50));
-  estimator_.add_navigation(*item.navigation);
+template <typename Out, typename In, typename Step>
+Out EpochPipeline::timed(Stage stage, In in, Step step) {
+  const auto i = static_cast<std::size_t>(stage);
+  epoch_of(in).clock.enter_ns[i] = monotonic_ns();
+  Out out = step(std::move(in));
+  IngestedEpoch& epoch = epoch_of(out);
+  epoch.clock.exit_ns[i] = monotonic_ns();
+  if (observer_.taken) observer_.taken(stage, epoch);
+  return out;
 }
+
+BridgedEpoch EpochPipeline::bridge(IngestedEpoch epoch) {
+  return timed<BridgedEpoch>(Stage::TimeBridge, std::move(epoch), [this](IngestedEpoch e) {
+    if (e.navigation) add_navigation(e);
+    return estimator_.bridge(std::move(e));
+  });
+}
+
+AlignedEpoch EpochPipeline::align(BridgedEpoch epoch) {
+  return timed<AlignedEpoch>(Stage::Alignment, std::move(epoch),
+                             [this](BridgedEpoch e) { return estimator_.align(std::move(e)); });
+}
+
+PredictedEpoch EpochPipeline::predict(AlignedEpoch epoch) {
+  return timed<PredictedEpoch>(Stage::Prediction, std::move(epoch),
+                               [this](AlignedEpoch e) { return estimator_.predict(std::move(e)); });
+}
+
+UpdatedEpoch EpochPipeline::update(PredictedEpoch epoch) {
+  return timed<UpdatedEpoch>(Stage::Update, std::move(epoch),
+                             [this](PredictedEpoch e) { return estimator_.update(std::move(e)); });
+}
+
+SolvedEpoch EpochPipeline::resolve(UpdatedEpoch epoch) {
+  SolvedEpoch solved = timed<SolvedEpoch>(Stage::Ambiguity, std::move(epoch),
+                                          [this](UpdatedEpoch e) { return estimator_.resolve(std::move(e)); });
+  if (observer_.solved) observer_.solved(solved);
+  return solved;
+}
+
+void EpochPipeline::sink(const SolvedEpoch& epoch) {
+  ++epochs_;
+  // After a failure (source or sink) the epochs already in the pipeline still go through its stages.
+  if (failed_.load()) return;
+  if (Status w = sink_(epoch); !w) fail(w.error());
+}
+
+void EpochPipeline::add_navigation(const IngestedEpoch& epoch) {
+  // Every earlier epoch has left the last stage (sequential: always so), then no stage reads the ephemerides.
+  while (epochs_.load() < epoch.seq) std::this_thread::sleep_for(std::chrono::microseconds(50));
+  estimator_.add_navigation(*epoch.navigation);
+}
+
+// ---- The layouts ----
 
 Status EpochPipeline::run_sequential() {
   for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
@@ -265,11 +310,10 @@ Status EpochPipeline::run_sequential() {
     auto next = source_.next();
     if (!next) return next.error();
     if (!*next) break;
-    EpochItem& item = **next;
-    ingested(item, seq, enter);
-    for (std::size_t s = 1; s < kNumStages; ++s) run_stage(static_cast<Stage>(s), item);
+    ingested(**next, seq, enter);
+    const SolvedEpoch solved = resolve(update(predict(align(bridge(std::move(**next))))));
     ++epochs_;
-    Status w = sink_(item);
+    Status w = sink_(solved);
     for (std::size_t s = 0; s < kNumStages; ++s) handed_on(static_cast<Stage>(s));
     if (!w) return w;
   }
@@ -282,45 +326,36 @@ Status EpochPipeline::run_bridge_ahead() {
   // most one wake-up per batch, not per epoch. And they go back to be freed where they were allocated: glibc gives
   // each thread its own heap arena, and this thread freeing the other's blocks contended for that arena's lock on
   // every epoch (about 300 futex waits on cssrlib-kinematic-doy265, which cost more than the second thread saved).
-  core::BatchQueue<ItemPtr> ready(options_.queue_capacity, kBridgeAheadBatch);
+  core::BatchQueue<BridgedEpoch> ready(options_.queue_capacity, kBridgeAheadBatch);
   std::mutex spent_mutex;
-  std::vector<ItemPtr> spent;  // under spent_mutex: epochs past the sink, for the ingest thread to free
+  std::vector<SolvedEpoch> spent;  // under spent_mutex: epochs past the sink, for the ingest thread to free
   std::thread ahead([this, &ready, &spent_mutex, &spent] {
-    std::vector<ItemPtr> to_free;
+    std::vector<SolvedEpoch> to_free;
     for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
       {
         const std::lock_guard lock(spent_mutex);
         to_free.swap(spent);
       }
       to_free.clear();
-      ItemPtr item = ingest_next(seq);
-      if (!item) break;
+      std::optional<IngestedEpoch> epoch = ingest_next(seq);
+      if (!epoch) break;
       // Fresh ephemerides wait for every earlier epoch to leave the last stage: those still batched must go first.
-      if (item->navigation && !ready.flush()) break;
-      run_stage(Stage::TimeBridge, *item);
-      if (!ready.push(std::move(item))) break;
+      if (epoch->navigation && !ready.flush()) break;
+      if (!ready.push(bridge(std::move(*epoch)))) break;
       handed_on(Stage::Ingest);
       handed_on(Stage::TimeBridge);
     }
     ready.close();
   });
-  while (std::optional<ItemPtr> item = ready.pop()) {
-    EpochItem& epoch = **item;
-    for (std::size_t s = static_cast<std::size_t>(Stage::Alignment); s < kNumStages; ++s) {
-      run_stage(static_cast<Stage>(s), epoch);
-    }
-    ++epochs_;
-    // After a failure (source or sink) the epochs already bridged still go through, as in run_threaded().
-    if (!failed_.load()) {
-      if (Status w = sink_(epoch); !w) fail(w.error());
-    }
+  while (std::optional<BridgedEpoch> epoch = ready.pop()) {
+    SolvedEpoch solved = resolve(update(predict(align(std::move(*epoch)))));
+    sink(solved);
     for (std::size_t s = static_cast<std::size_t>(Stage::Alignment); s < kNumStages; ++s) {
       handed_on(static_cast<Stage>(s));
     }
-    epoch.output.reset();  // this thread's allocations: freed here
-    epoch.error.reset();
+    solved.output = Error{};  // this thread's allocations: freed here
     const std::lock_guard lock(spent_mutex);
-    spent.push_back(std::move(*item));
+    spent.push_back(std::move(solved));
   }
   ahead.join();  // the epochs still in `spent` are freed here, with the vector
   full_waits_[static_cast<std::size_t>(Stage::TimeBridge)] = ready.full_waits();
@@ -336,67 +371,64 @@ void EpochPipeline::pin(Stage stage) {
   }
 }
 
+template <typename In, typename Out, typename Step>
+void EpochPipeline::stage_thread(Stage stage, core::SpscHandoff<std::optional<In>>& in,
+                                 core::SpscHandoff<std::optional<Out>>& out, Step step) {
+  const auto out_index = static_cast<std::size_t>(stage);  // queue i joins stage i to stage i + 1
+  pin(stage);
+  bool first = true;
+  for (;;) {
+    std::optional<In> epoch = in.pop();
+    if (!epoch) break;
+    if (stage == Stage::Alignment) {
+      if (!first) (void)queues_->tokens.pop();  // the estimator is free: the last epoch left the ambiguity stage
+      first = false;
+    }
+    if (out.push(step(std::move(*epoch)))) ++full_waits_[out_index];  // never drops: back-pressure
+    handed_on(stage);
+  }
+  if (out.push(std::nullopt)) ++full_waits_[out_index];
+}
+
 Status EpochPipeline::run_threaded() {
   if (const std::string e = options_.unavailable_cpu(); !e.empty()) return Error{"pipeline: " + e};
   const std::vector<int> caller_cpus = this_thread_cpus();  // this thread runs the last stage, then gets them back
   Queues& q = *queues_;
-  const auto push = [this, &q](std::size_t i, ItemPtr item) {
-    if (q.between[i]->push(std::move(item))) ++full_waits_[i];  // never drops: back-pressure
-  };
-
-  // Ingest.
-  std::thread ingest([this, &push] {
+  std::thread ingest([this, &q] {
     pin(Stage::Ingest);
     for (std::uint64_t seq = 0; !stop_.load(); ++seq) {
-      ItemPtr item = ingest_next(seq);
-      if (!item) break;
-      push(0, std::move(item));
+      std::optional<IngestedEpoch> epoch = ingest_next(seq);
+      if (!epoch) break;
+      if (q.ingested.push(std::move(epoch))) ++full_waits_[0];
       handed_on(Stage::Ingest);
     }
-    push(0, nullptr);
+    if (q.ingested.push(std::nullopt)) ++full_waits_[0];
   });
-
-  // Middle stages: time bridge, alignment (waits for the token), prediction, update.
-  const auto middle = [this, &q, &push](Stage stage) {
-    const auto in = static_cast<std::size_t>(stage) - 1;
-    pin(stage);
-    bool first = true;
-    for (;;) {
-      ItemPtr item = q.between[in]->pop();
-      if (!item) break;
-      if (stage == Stage::Alignment) {
-        if (!first) (void)q.tokens.pop();
-        first = false;
-      }
-      run_stage(stage, *item);
-      push(in + 1, std::move(item));
-      handed_on(stage);
-    }
-    push(in + 1, nullptr);
-  };
-  std::thread bridge(middle, Stage::TimeBridge);
-  std::thread align(middle, Stage::Alignment);
-  std::thread predict(middle, Stage::Prediction);
-  std::thread update(middle, Stage::Update);
-
+  std::thread bridge_thread([this, &q] {
+    stage_thread(Stage::TimeBridge, q.ingested, q.bridged, [this](IngestedEpoch e) { return bridge(std::move(e)); });
+  });
+  std::thread align_thread([this, &q] {
+    stage_thread(Stage::Alignment, q.bridged, q.aligned, [this](BridgedEpoch e) { return align(std::move(e)); });
+  });
+  std::thread predict_thread([this, &q] {
+    stage_thread(Stage::Prediction, q.aligned, q.predicted, [this](AlignedEpoch e) { return predict(std::move(e)); });
+  });
+  std::thread update_thread([this, &q] {
+    stage_thread(Stage::Update, q.predicted, q.updated, [this](PredictedEpoch e) { return update(std::move(e)); });
+  });
   // Ambiguity resolution and the sink, on this thread.
   pin(Stage::Ambiguity);
-  for (;;) {
-    ItemPtr item = q.between[kNumStages - 2]->pop();
-    if (!item) break;
-    run_stage(Stage::Ambiguity, *item);
+  while (std::optional<UpdatedEpoch> epoch = q.updated.pop()) {
+    const SolvedEpoch solved = resolve(std::move(*epoch));
     (void)q.tokens.push(true);  // the estimator is free for the next epoch's alignment
-    ++epochs_;
-    if (!failed_.load()) {
-      if (Status w = sink_(*item); !w) fail(w.error());
-    }
+    sink(solved);
     handed_on(Stage::Ambiguity);
   }
   ingest.join();
-  bridge.join();
-  align.join();
-  predict.join();
-  update.join();
+  bridge_thread.join();
+  align_thread.join();
+  predict_thread.join();
+  update_thread.join();
   if (options_.pinned() && !caller_cpus.empty()) (void)pin_this_thread(caller_cpus);
   estimator_.finish();
   return Ok{};

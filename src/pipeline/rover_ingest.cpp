@@ -52,7 +52,7 @@ RoverIngest::Summary stream_summary(const std::string& name, const ByteLink* lin
 
 }  // namespace
 
-void RoverIngest::attach_link_counts(EpochItem& item) const {
+void RoverIngest::attach_link_counts(IngestedEpoch& item) const {
   if (rover_.receiver) item.rover_link = link_counts(&rover_.receiver->link(), rover_.receiver->decoder());
   if (live_) item.base_link = link_counts(base_.link.get(), live_->decoder());
 }
@@ -153,13 +153,13 @@ Result<std::optional<core::ObsEpoch>> RoverIngest::next_rover() {
   return Error{"rover ingest: no rover input"};
 }
 
-Result<std::optional<EpochItem>> RoverIngest::next() {
+Result<std::optional<IngestedEpoch>> RoverIngest::next() {
   auto next = next_rover();
   if (!next) return next.error();
-  if (!*next) return std::optional<EpochItem>{};
-  std::optional<EpochItem> item(std::in_place);
+  if (!*next) return std::optional<IngestedEpoch>{};
+  std::optional<IngestedEpoch> item(std::in_place);
   item->rover = std::move(**next);
-  if (!wait_until_due(item->rover.time)) return std::optional<EpochItem>{};  // stopped
+  if (!wait_until_due(item->rover.time)) return std::optional<IngestedEpoch>{};  // stopped
   if (Status s = attach_base(*item); !s) return s.error();
   attach_navigation(*item);
   attach_link_counts(*item);
@@ -178,7 +178,7 @@ bool RoverIngest::wait_until_due(const core::GpsTime& t) {
   return false;
 }
 
-Status RoverIngest::attach_base(EpochItem& item) {
+Status RoverIngest::attach_base(IngestedEpoch& item) {
   const core::GpsTime t = item.rover.time;
   if (base_.file) {
     auto base = base_.file->at(t);
@@ -205,7 +205,7 @@ Status RoverIngest::attach_base(EpochItem& item) {
   return Ok{};
 }
 
-void RoverIngest::attach_base_position(EpochItem& item) {
+void RoverIngest::attach_base_position(IngestedEpoch& item) {
   const std::optional<Eigen::Vector3d> p = live_->station_position();
   if (!p) {
     // Without the base position the base epoch cannot be differenced: the rover epoch goes on alone.
@@ -228,7 +228,7 @@ void RoverIngest::attach_base_position(EpochItem& item) {
   item.base_position_E_m = *p;
 }
 
-void RoverIngest::attach_navigation(EpochItem& item) {
+void RoverIngest::attach_navigation(IngestedEpoch& item) {
   if (!options_.stream_ephemerides) return;
   std::shared_ptr<const core::NavigationData> rover = rover_.receiver ? rover_.receiver->take_navigation() : nullptr;
   std::shared_ptr<const core::NavigationData> base =

@@ -18,6 +18,8 @@
 #include "canyon/dds/rover_msgs.hpp"
 #include "canyon/pipeline/monitor_model.hpp"
 
+#include "pipeline/fake_epochs.hpp"
+
 namespace canyon::dds {
 namespace {
 
@@ -25,9 +27,12 @@ int test_domain() {
   return 100 + static_cast<int>((::getpid() + 37) % 100);
 }
 
-pipeline::EpochItem solved_item(std::uint64_t seq) {
-  pipeline::EpochItem item;
+pipeline::SolvedEpoch solved_item(std::uint64_t seq, const pipeline::LinkCounts& rover_link = {},
+                                  const pipeline::LinkCounts& base_link = {}) {
+  pipeline::IngestedEpoch item;
   item.seq = seq;
+  item.rover_link = rover_link;
+  item.base_link = base_link;
   item.rover.time = core::GpsTime{2300, 1000.0 + 0.2 * static_cast<double>(seq)};
   pipeline::EpochOutput out;
   out.solution.time = item.rover.time;
@@ -39,8 +44,7 @@ pipeline::EpochItem solved_item(std::uint64_t seq) {
   out.solution.ratio = 12.345678901;
   out.solution.age_s = 0.2;
   out.ar_pruned = {core::SatelliteId{core::Constellation::Gps, 5}};
-  item.output = out;
-  return item;
+  return pipeline::testing::solved_epoch(std::move(item), out);
 }
 
 void wait_for(const std::function<bool()>& done, double timeout_s = 10.0) {
@@ -55,9 +59,7 @@ TEST(RoverMsgs, TimingCarriesTheDropCounts) {
   context.malformed_samples = 5;
   context.vio_dropped = 7;
   context.vio_late = 11;
-  pipeline::EpochItem item = solved_item(2);
-  item.rover_link = pipeline::LinkCounts{1, 2, 3, 4};
-  item.base_link = pipeline::LinkCounts{5, 6, 7, 8};
+  const pipeline::SolvedEpoch item = solved_item(2, pipeline::LinkCounts{1, 2, 3, 4}, pipeline::LinkCounts{5, 6, 7, 8});
   const pipeline::TimingSample t = to_sample(to_msg_timing(item, context));
   EXPECT_EQ(t.rover_link.dropped_bytes, 1U);
   EXPECT_EQ(t.rover_link.undecodable, 4U);
@@ -71,7 +73,7 @@ TEST(RoverMsgs, TimingCarriesTheDropCounts) {
 }
 
 TEST(RoverMsgs, SolutionRoundTripsBitForBit) {
-  const pipeline::EpochItem item = solved_item(7);
+  const pipeline::SolvedEpoch item = solved_item(7);
   EpochContext context;
   context.rover_id = "r1";
   const msg::Solution m = to_msg_solution(item, context);

@@ -28,6 +28,8 @@
 #include "canyon/config/scenario_config.hpp"
 #include "canyon/pipeline/cpu_affinity.hpp"
 
+#include "pipeline/fake_epochs.hpp"
+
 namespace canyon::pipeline {
 namespace {
 
@@ -149,11 +151,11 @@ core::ObsEpoch epoch_at(double tow_s) {
 class CountingSource final : public EpochSource {
  public:
   CountingSource(int n, std::chrono::microseconds delay) : n_(n), delay_(delay) {}
-  Result<std::optional<EpochItem>> next() override {
-    if (n_ >= 0 && produced_.load() >= n_) return std::optional<EpochItem>{};
+  Result<std::optional<IngestedEpoch>> next() override {
+    if (n_ >= 0 && produced_.load() >= n_) return std::optional<IngestedEpoch>{};
     if (fail_at_ >= 0 && produced_.load() == fail_at_) return Error{"source broke"};
     std::this_thread::sleep_for(delay_);
-    std::optional<EpochItem> item(std::in_place);
+    std::optional<IngestedEpoch> item(std::in_place);
     item->rover = epoch_at(produced_.load());
     produced_.fetch_add(1);
     return item;
@@ -166,29 +168,38 @@ class CountingSource final : public EpochSource {
   std::chrono::microseconds delay_;
 };
 
+using testing::bridged_without_geometry;
+
 /// Records the order in which each stage saw epochs; resolve() makes the output.
 class RecordingEstimator final : public EpochEstimator {
  public:
-  void bridge(EpochItem& item) const override { (void)item; }
-  void align(EpochItem& item) override { check(item, in_align_); }
-  void predict(EpochItem& item) override {
-    check(item, in_predict_);
-    item.to_update = true;
+  [[nodiscard]] BridgedEpoch bridge(IngestedEpoch epoch) const override {
+    return bridged_without_geometry(std::move(epoch));
   }
-  void update(EpochItem& item) override { item.to_resolve = true; }
-  void resolve(EpochItem& item) override {
+  [[nodiscard]] AlignedEpoch align(BridgedEpoch epoch) override {
+    check(epoch.epoch, in_align_);
+    return AlignedEpoch{std::move(epoch)};
+  }
+  [[nodiscard]] PredictedEpoch predict(AlignedEpoch epoch) override {
+    check(epoch.bridged.epoch, in_predict_);
+    return PredictedEpoch{std::move(epoch), true};
+  }
+  [[nodiscard]] UpdatedEpoch update(PredictedEpoch epoch) override { return UpdatedEpoch{std::move(epoch), true}; }
+  [[nodiscard]] SolvedEpoch resolve(UpdatedEpoch epoch) override {
     // The token: alignment of epoch k+1 never runs before the ambiguity stage finished epoch k.
     EXPECT_EQ(busy_.exchange(false), true);
+    SolvedEpoch solved{std::move(epoch)};
     EpochOutput out;
-    out.solution.time = item.rover.time;
+    out.solution.time = solved.epoch().rover.time;
     out.solution.status = core::SolutionStatus::Fixed;
-    item.output = out;
+    solved.output = out;
+    return solved;
   }
   void finish() override { finished = true; }
   bool finished = false;
 
  private:
-  void check(const EpochItem& item, std::uint64_t& next) {
+  void check(const IngestedEpoch& item, std::uint64_t& next) {
     EXPECT_EQ(item.seq, next);
     ++next;
     if (&next == &in_align_) {
@@ -204,7 +215,7 @@ void expect_full_queues_block_and_drop_nothing(const PipelineOptions& options) {
   CountingSource source(200, std::chrono::microseconds(0));
   RecordingEstimator estimator;
   std::vector<double> seen;
-  const auto slow_sink = [&seen](const EpochItem& item) -> Status {
+  const auto slow_sink = [&seen](const SolvedEpoch& item) -> Status {
     std::this_thread::sleep_for(std::chrono::microseconds(200));
     seen.push_back(item.output->solution.time.tow_s);
     return Ok{};
@@ -230,14 +241,19 @@ TEST(EpochPipeline, FullQueuesBlockTheProducerAndDropNothing) {
 /// Counts the epochs between the time bridge and the ambiguity stage; add_navigation() must find none.
 class InFlightEstimator final : public EpochEstimator {
  public:
-  void bridge(EpochItem& /*item*/) const override { in_flight_.fetch_add(1); }
-  void align(EpochItem& /*item*/) override {}
-  void predict(EpochItem& item) override { item.to_update = true; }
-  void update(EpochItem& item) override { item.to_resolve = true; }
-  void resolve(EpochItem& item) override {
+  [[nodiscard]] BridgedEpoch bridge(IngestedEpoch epoch) const override {
+    in_flight_.fetch_add(1);
+    return bridged_without_geometry(std::move(epoch));
+  }
+  [[nodiscard]] AlignedEpoch align(BridgedEpoch epoch) override { return AlignedEpoch{std::move(epoch)}; }
+  [[nodiscard]] PredictedEpoch predict(AlignedEpoch epoch) override { return PredictedEpoch{std::move(epoch), true}; }
+  [[nodiscard]] UpdatedEpoch update(PredictedEpoch epoch) override { return UpdatedEpoch{std::move(epoch), true}; }
+  [[nodiscard]] SolvedEpoch resolve(UpdatedEpoch epoch) override {
     std::this_thread::sleep_for(std::chrono::microseconds(100));  // the later stages lag: epochs pile up
-    item.output.emplace();
+    SolvedEpoch solved{std::move(epoch)};
+    solved.output = EpochOutput{};
     in_flight_.fetch_sub(1);
+    return solved;
   }
   void finish() override {}
   void add_navigation(const core::NavigationData& fresh) override {
@@ -257,7 +273,7 @@ TEST(EpochPipeline, EphemeridesAreAddedWhileNoStageRuns) {
     CountingSource counting(200, std::chrono::microseconds(0));
     struct WithNavigation final : EpochSource {
       explicit WithNavigation(CountingSource& s) : source(s) {}
-      Result<std::optional<EpochItem>> next() override {
+      Result<std::optional<IngestedEpoch>> next() override {
         auto item = source.next();
         if (item && *item && source.produced_.load() % 10 == 0) {
           auto nav = std::make_shared<core::NavigationData>();
@@ -272,7 +288,7 @@ TEST(EpochPipeline, EphemeridesAreAddedWhileNoStageRuns) {
     std::size_t solved = 0;
     EpochPipeline pipeline(
         source, estimator,
-        [&solved](const EpochItem&) -> Status {
+        [&solved](const SolvedEpoch&) -> Status {
           ++solved;
           return Ok{};
         },
@@ -289,16 +305,17 @@ TEST(EpochPipeline, EmptyQueuesWaitForASlowSource) {
   int sunk = 0;
   EpochPipeline pipeline(
       source, estimator,
-      [&sunk](const EpochItem& item) -> Status {
-        EXPECT_TRUE(item.output.has_value());
+      [&sunk](const SolvedEpoch& solved) -> Status {
+        EXPECT_TRUE(solved.output.ok());
         // Every stage stamped the epoch, in order, after its arrival.
+        const StageClock& clock = solved.epoch().clock;
         for (std::size_t s = 0; s < kNumStages; ++s) {
-          EXPECT_LE(item.enter_ns[s], item.exit_ns[s]);
+          EXPECT_LE(clock.enter_ns[s], clock.exit_ns[s]);
           if (s > 0) {
-            EXPECT_LE(item.exit_ns[s - 1], item.enter_ns[s]);
+            EXPECT_LE(clock.exit_ns[s - 1], clock.enter_ns[s]);
           }
         }
-        EXPECT_LE(item.arrival_ns, item.exit_ns[kNumStages - 1]);
+        EXPECT_LE(solved.epoch().arrival_ns, clock.exit_ns[kNumStages - 1]);
         ++sunk;
         return Ok{};
       },
@@ -324,9 +341,9 @@ TEST(EpochPipeline, ObserverTakesThenHandsOnEachEpochOnItsStageThread) {
     std::array<StageLog, kNumStages> logs;  // each written by its stage's thread only
     std::atomic<int> sunk{0};
     StageObserver observer;
-    observer.taken = [&logs](Stage stage, const EpochItem& item) {
+    observer.taken = [&logs](Stage stage, const IngestedEpoch& item) {
       StageLog& log = logs[static_cast<std::size_t>(stage)];
-      EXPECT_GT(item.exit_ns[static_cast<std::size_t>(stage)], 0);
+      EXPECT_GT(item.clock.exit_ns[static_cast<std::size_t>(stage)], 0);
       log.events.push_back('t');
       log.taken_seq.push_back(item.seq);
       log.threads.insert(std::this_thread::get_id());
@@ -339,7 +356,7 @@ TEST(EpochPipeline, ObserverTakesThenHandsOnEachEpochOnItsStageThread) {
     };
     EpochPipeline pipeline(
         source, estimator,
-        [&sunk](const EpochItem&) -> Status {
+        [&sunk](const SolvedEpoch&) -> Status {
           sunk.fetch_add(1);
           return Ok{};
         },
@@ -372,11 +389,11 @@ TEST(EpochPipeline, PinnedStageThreadsRunOnTheirCpus) {
   RecordingEstimator estimator;
   std::array<std::set<int>, kNumStages> cpus_seen;  // each written by its stage's thread only
   StageObserver observer;
-  observer.taken = [&cpus_seen](Stage stage, const EpochItem&) {
+  observer.taken = [&cpus_seen](Stage stage, const IngestedEpoch&) {
     cpus_seen[static_cast<std::size_t>(stage)].insert(sched_getcpu());
   };
   EpochPipeline pipeline(
-      source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, options, observer);
+      source, estimator, [](const SolvedEpoch&) -> Status { return Ok{}; }, options, observer);
   ASSERT_TRUE(pipeline.run().ok());
   for (std::size_t s = 0; s < kNumStages; ++s) {
     const std::set<int> pinned(options.cpu_affinity[s].begin(), options.cpu_affinity[s].end());
@@ -389,7 +406,7 @@ TEST(EpochPipeline, PinnedStageThreadsRunOnTheirCpus) {
   ASSERT_EQ(far.validate(), "");
   CountingSource unread(5, std::chrono::microseconds(0));
   EpochPipeline refused(
-      unread, estimator, [](const EpochItem&) -> Status { return Ok{}; }, far);
+      unread, estimator, [](const SolvedEpoch&) -> Status { return Ok{}; }, far);
   const Status s = refused.run();
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("pipeline: cpu_affinity.update: CPU 1023 is not one this process may run on"),
@@ -406,7 +423,7 @@ void expect_stop_finishes_the_epochs_in_flight(const PipelineOptions& options) {
   EpochPipeline* self = nullptr;
   EpochPipeline pipeline(
       source, estimator,
-      [&sunk, &self](const EpochItem& /*item*/) -> Status {
+      [&sunk, &self](const SolvedEpoch& /*item*/) -> Status {
         std::this_thread::sleep_for(std::chrono::microseconds(300));  // the queues fill up behind
         if (sunk.fetch_add(1) == 50) self->stop();
         return Ok{};
@@ -433,7 +450,7 @@ TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {
     source.fail_at_ = 30;
     RecordingEstimator estimator;
     EpochPipeline pipeline(
-        source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, options);
+        source, estimator, [](const SolvedEpoch&) -> Status { return Ok{}; }, options);
     const Status s = pipeline.run();
     ASSERT_FALSE(s.ok()) << name;
     EXPECT_EQ(s.error().message, "source broke") << name;
@@ -444,7 +461,7 @@ TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {
     int sunk = 0;
     EpochPipeline pipeline(
         source, estimator,
-        [&sunk](const EpochItem&) -> Status {
+        [&sunk](const SolvedEpoch&) -> Status {
           if (++sunk == 10) return Error{"disk full", "out.pos", 0};
           return Ok{};
         },
@@ -458,7 +475,7 @@ TEST(EpochPipeline, SourceAndSinkErrorsStopWithoutHanging) {
   CountingSource source(1, std::chrono::microseconds(0));
   RecordingEstimator estimator;
   EpochPipeline bad(
-      source, estimator, [](const EpochItem&) -> Status { return Ok{}; }, PipelineOptions{true, 0});
+      source, estimator, [](const SolvedEpoch&) -> Status { return Ok{}; }, PipelineOptions{true, 0});
   const Status s = bad.run();
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("queue_capacity"), std::string::npos);

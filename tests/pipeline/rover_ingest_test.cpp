@@ -234,7 +234,7 @@ TEST(RoverIngest, StreamedBasePositionComesFromThe1005AndEpochsBeforeItGoOnWitho
   RoverIngest ingest(
       std::move(rover_input), std::move(base), ingest_options, [] { return false; },
       [&](const std::string& w) { warnings.push_back(w); });
-  std::vector<EpochItem> items;
+  std::vector<IngestedEpoch> items;
   for (int k = 0; k < 25; ++k) {
     auto item = ingest.next();
     ASSERT_TRUE(item) << item.error().to_string();

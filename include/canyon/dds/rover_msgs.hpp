@@ -33,16 +33,16 @@ struct EpochContext {
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
 };
 
-[[nodiscard]] msg::StageStamps to_msg_stamps(const pipeline::EpochItem& item);
+[[nodiscard]] msg::StageStamps to_msg_stamps(const pipeline::IngestedEpoch& item);
 /// The epoch's solution (status 0 with the reason in `note` when it has none).
-[[nodiscard]] msg::Solution to_msg_solution(const pipeline::EpochItem& item, const EpochContext& context);
-[[nodiscard]] msg::StageTiming to_msg_timing(const pipeline::EpochItem& item, const EpochContext& context);
-[[nodiscard]] msg::BridgedEpoch to_msg_bridged(const pipeline::EpochItem& item);
+[[nodiscard]] msg::Solution to_msg_solution(const pipeline::SolvedEpoch& solved, const EpochContext& context);
+[[nodiscard]] msg::StageTiming to_msg_timing(const pipeline::SolvedEpoch& solved, const EpochContext& context);
+[[nodiscard]] msg::BridgedEpoch to_msg_bridged(const pipeline::SolvedEpoch& solved);
 /// The prediction's prior, the update's float solution and the alignment in use, of an epoch that left the last
 /// stage (the engines hand them over with the epoch's result).
-[[nodiscard]] msg::Prior to_msg_prior(const pipeline::EpochItem& item);
-[[nodiscard]] msg::FloatSolution to_msg_float(const pipeline::EpochItem& item);
-[[nodiscard]] msg::Alignment to_msg_alignment(const pipeline::EpochItem& item);
+[[nodiscard]] msg::Prior to_msg_prior(const pipeline::SolvedEpoch& solved);
+[[nodiscard]] msg::FloatSolution to_msg_float(const pipeline::SolvedEpoch& solved);
+[[nodiscard]] msg::Alignment to_msg_alignment(const pipeline::SolvedEpoch& solved);
 
 /// The solution for a .pos/NMEA writer; Error if the message is malformed (bad status, sizes, non-finite values).
 Result<core::Solution> from_msg(const msg::Solution& m);

@@ -1,6 +1,6 @@
 #pragma once
 // The rover's per-epoch outputs: the one place where canyon rover meets the pipeline's stage messages
-// (pipeline::EpochItem, pipeline::StageObserver, pipeline::EpochSink) besides the conversions of rover_msgs.hpp.
+// (pipeline::SolvedEpoch, pipeline::StageObserver, pipeline::EpochSink) besides the conversions of rover_msgs.hpp.
 //   - sink(): the epoch's solution to the .pos (estimator.out) and, for an NTRIP base, as the GGA the link uploads;
 //     the epoch counts;
 //   - observer(): the solution is published the moment the ambiguity stage has it. The stage outputs (canyon/bridged,
@@ -59,10 +59,10 @@ class RoverOutputs {
   [[nodiscard]] std::uint64_t fixed() const { return fixed_; }
 
  private:
-  Status write_epoch(const pipeline::EpochItem& item);
-  void taken(pipeline::Stage stage, const pipeline::EpochItem& item);
+  Status write_epoch(const pipeline::SolvedEpoch& item);
+  void take_solved(const pipeline::SolvedEpoch& item);
   void handed_on(pipeline::Stage stage);
-  void update_context(const pipeline::EpochItem& item);
+  void update_context(const pipeline::SolvedEpoch& item);
 
   std::string rover_id_;
   std::unique_ptr<SolutionWriter> solution_;

@@ -2,7 +2,9 @@
 // The estimation as six stages, run in order on one thread, in order with ingest and the time bridge on a second
 // thread running ahead (`canyon process`), or as six threads joined by bounded lock-free single-producer/single-
 // consumer queues (`canyon rover`). All three modes call the same stage functions on the same engine in the same
-// order, so they give the same solutions (tests/app/epoch_pipeline_test).
+// order, so they give the same solutions (tests/pipeline/epoch_pipeline_test). The messages between the stages are
+// typed per stage (stage_messages.hpp): IngestedEpoch, BridgedEpoch, AlignedEpoch, PredictedEpoch, UpdatedEpoch,
+// SolvedEpoch.
 //
 //   ingest ──▶ time bridge ──▶ alignment ──▶ prediction ──▶ update ──▶ ambiguity resolution ──▶ sink
 //      │  rover epoch + base   epoch geometry pending T_EO /  VIO increment  gated DD EKF   MLAMBDA, ratio, pruning,
@@ -27,8 +29,8 @@
 // then reads its input later) until the consumer has taken it down to half (core::SpscHandoff); each time a producer
 // finds its queue full is counted (PipelineStats::full_waits). PipelineOptions::cpu_affinity pins stage threads.
 // Stop (stop()): ingest stops reading; every epoch already ingested goes through every stage and reaches the sink.
-// Ephemerides that arrive while running (EpochItem::navigation, rare: a satellite's new ephemeris every hour or two)
-// drain the pipeline: that epoch enters the time bridge once every earlier epoch has left the last stage.
+// Ephemerides that arrive while running (IngestedEpoch::navigation, rare: a satellite's new ephemeris every hour or
+// two) drain the pipeline: that epoch enters the time bridge once every earlier epoch has left the last stage.
 
 #include <array>
 #include <atomic>
@@ -44,116 +46,59 @@
 #include "canyon/core/observation.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
+#include "canyon/core/spsc_handoff.hpp"
 #include "canyon/fusion/fusion_engine.hpp"
 #include "canyon/fusion/fusion_geometry.hpp"
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/pipeline/link_counts.hpp"
+#include "canyon/pipeline/stage_messages.hpp"
 #include "canyon/rtk/engine.hpp"
 
 namespace canyon::pipeline {
 
-enum class Stage : std::uint8_t { Ingest, TimeBridge, Alignment, Prediction, Update, Ambiguity };
-inline constexpr std::size_t kNumStages = 6;
-/// "ingest", "time_bridge", "alignment", "prediction", "update", "ambiguity".
-[[nodiscard]] const char* stage_name(Stage stage);
 /// The pipeline clock: monotonic nanoseconds (steady_clock).
 [[nodiscard]] std::int64_t monotonic_ns();
-
-/// The epoch's output.
-struct EpochOutput {
-  core::Solution solution;
-  double hdop = 0.0;
-  std::string note;  ///< why not fixed
-  std::vector<core::SatelliteId> rejected;
-  std::vector<core::SatelliteId> ar_pruned;
-  bool aided = false;
-  /// The update stage's float solution and the prediction's prior (aided epochs), from the RTK engine.
-  bool has_float = false;
-  Eigen::Vector3d float_p_E_m = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d float_P_E_m2 = Eigen::Matrix3d::Zero();
-  int dd_phase_rows = 0;
-  int dd_code_rows = 0;
-  double max_post_fit_normalised = 0.0;
-  bool has_prior = false;
-  Eigen::Vector3d prior_p_E_m = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d prior_P_E_m2 = Eigen::Matrix3d::Zero();
-  /// Fusion: the last accepted alignment (RMSE, first eigenvalue ratio) and the lever arm in use.
-  struct Alignment {
-    std::string kind;
-    double rmse_m = 0.0;
-    double first_eigenvalue_ratio = 0.0;
-    Eigen::Vector3d t_IA_m = Eigen::Vector3d::Zero();
-  };
-  std::optional<Alignment> alignment;
-};
-
-/// One epoch on its way through the stages.
-struct EpochItem {
-  std::uint64_t seq = 0;  ///< 0, 1, 2, ... in ingest order
-  core::ObsEpoch rover;
-  std::optional<core::ObsEpoch> base;  ///< the base epoch to use (a copy: ingest runs ahead of the cursor's users)
-  std::int64_t arrival_ns = 0;    ///< the epoch complete at ingest, rover and base (pipeline clock; 0: the pipeline
-                                  ///< stamps it when the source returns it); the ingest stage is timed from it
-  std::int64_t base_send_ns = 0;  ///< the base's send time of its epoch's last frame (DDS base; 0 otherwise)
-  /// A base position that arrived on the base's stream (RTCM 1005/1006) and holds from this epoch on; set by ingest
-  /// on the first epoch that has it and whenever it changes. The stages apply it with the epoch (the time bridge's
-  /// geometry, the prediction's engine), so threaded and sequential runs use the same position for the same epoch.
-  std::optional<Eigen::Vector3d> base_position_E_m;
-  LinkCounts rover_link;  ///< the receiver's stream (ubx input), as ingest left it with this epoch
-  LinkCounts base_link;   ///< the base's stream (dds, ntrip, tcp)
-  /// Ephemerides that arrived on the rover's or the base's stream before this epoch (nullptr: none). The pipeline
-  /// hands them to EpochEstimator::add_navigation() before the epoch's time bridge, once every earlier epoch has
-  /// left the last stage: no stage reads the ephemerides meanwhile, and threaded and sequential runs use the same
-  /// ephemerides for the same epoch.
-  std::shared_ptr<const core::NavigationData> navigation;
-  std::array<std::int64_t, kNumStages> enter_ns{};  ///< per stage (pipeline clock)
-  std::array<std::int64_t, kNumStages> exit_ns{};
-  std::optional<fusion::VioPoseAt> pose;       ///< time bridge (fusion)
-  std::optional<rtk::EpochGeometry> geometry;  ///< time bridge (rtk): the epoch's filter-independent geometry
-  std::optional<fusion::FusionGeometry> fusion_geometry;  ///< time bridge (fusion): the same with the C/N0 screen
-  bool to_update = false;                                 ///< prediction's verdict: the epoch goes on to the update
-  bool to_resolve = false;            ///< update's verdict: the epoch goes on to ambiguity resolution
-  std::optional<Error> error;         ///< no solution at all (the reason)
-  std::optional<EpochOutput> output;  ///< the solution (after the ambiguity stage)
-};
 
 /// Where epochs come from (the ingest stage): a rover epoch with its base epoch.
 class EpochSource {
  public:
   virtual ~EpochSource() = default;
   /// The next epoch (rover, base; seq and times are set by the pipeline); nullopt at the end of the input.
-  virtual Result<std::optional<EpochItem>> next() = 0;
+  virtual Result<std::optional<IngestedEpoch>> next() = 0;
 };
 
-/// The estimator's stages (see the engines' headers for what each does). bridge() is const and may run on another
-/// thread than the others; the others run one epoch at a time, in order.
+/// The estimator's stages (see the engines' headers for what each does), each taking its stage's input message and
+/// making its output. bridge() is const and may run on another thread than the others; the others run one epoch at
+/// a time, in order.
 class EpochEstimator {
  public:
   virtual ~EpochEstimator() = default;
-  virtual void bridge(EpochItem& item) const = 0;
-  virtual void align(EpochItem& item) = 0;
-  virtual void predict(EpochItem& item) = 0;
-  virtual void update(EpochItem& item) = 0;
+  [[nodiscard]] virtual BridgedEpoch bridge(IngestedEpoch epoch) const = 0;
+  [[nodiscard]] virtual AlignedEpoch align(BridgedEpoch epoch) = 0;
+  [[nodiscard]] virtual PredictedEpoch predict(AlignedEpoch epoch) = 0;
+  /// The update, when the prediction's verdict asks for it.
+  [[nodiscard]] virtual UpdatedEpoch update(PredictedEpoch epoch) = 0;
   /// Ambiguity resolution (when the update asked for it) and the epoch's output.
-  virtual void resolve(EpochItem& item) = 0;
+  [[nodiscard]] virtual SolvedEpoch resolve(UpdatedEpoch epoch) = 0;
   /// End of the input (a pending alignment).
   virtual void finish() = 0;
-  /// Ephemerides that arrived while running (EpochItem::navigation), for the store the stages read. The pipeline
-  /// calls it while no stage runs (see EpochItem::navigation). Default: ignored.
+  /// Ephemerides that arrived while running (IngestedEpoch::navigation), for the store the stages read. The pipeline
+  /// calls it while no stage runs (see IngestedEpoch::navigation). Default: ignored.
   virtual void add_navigation(const core::NavigationData& /*fresh*/) {}
 };
 
 /// RTK (rtk::RtkEngine): no VIO and no alignment; the time bridge builds each epoch's geometry (single-point
-/// solution, observables, satellite states, cycle-slip scan: rtk/epoch_geometry.hpp) ahead of the filter.
+/// solution, observables, satellite states, cycle-slip scan: rtk/epoch_geometry.hpp) ahead of the filter, and bridges
+/// no time.
 class RtkEstimator final : public EpochEstimator {
  public:
   explicit RtkEstimator(rtk::RtkEngine& engine)
       : engine_(engine), geometry_(engine.geometry_options(), engine.ephemerides(), engine.base_position_E_m()) {}
-  void bridge(EpochItem& item) const override;
-  void align(EpochItem& /*item*/) override {}
-  void predict(EpochItem& item) override;
-  void update(EpochItem& item) override;
-  void resolve(EpochItem& item) override;
+  [[nodiscard]] BridgedEpoch bridge(IngestedEpoch epoch) const override;
+  [[nodiscard]] AlignedEpoch align(BridgedEpoch epoch) override { return AlignedEpoch{std::move(epoch)}; }
+  [[nodiscard]] PredictedEpoch predict(AlignedEpoch epoch) override;
+  [[nodiscard]] UpdatedEpoch update(PredictedEpoch epoch) override;
+  [[nodiscard]] SolvedEpoch resolve(UpdatedEpoch epoch) override;
   void finish() override {}
 
  private:
@@ -165,17 +110,17 @@ class RtkEstimator final : public EpochEstimator {
 class LiveVio;
 
 /// The paper's fusion (fusion::FusionEngine). The time bridge builds each epoch's geometry (fusion/fusion_geometry.hpp)
-/// ahead of the filter, then takes its VIO pose; with a live VIO stream (pipeline/live_vio.hpp) it waits for the VIO to
-/// cover the epoch.
+/// ahead of the filter, then takes its VIO pose at the epoch's GPST; with a live VIO stream (live_vio.hpp) it waits
+/// for the VIO to cover the epoch.
 class FusionEstimator final : public EpochEstimator {
  public:
   explicit FusionEstimator(fusion::FusionEngine& engine, LiveVio* live_vio = nullptr)
       : engine_(engine), live_vio_(live_vio), geometry_(engine.make_geometry_builder()) {}
-  void bridge(EpochItem& item) const override;
-  void align(EpochItem& item) override;
-  void predict(EpochItem& item) override;
-  void update(EpochItem& item) override;
-  void resolve(EpochItem& item) override;
+  [[nodiscard]] BridgedEpoch bridge(IngestedEpoch epoch) const override;
+  [[nodiscard]] AlignedEpoch align(BridgedEpoch epoch) override;
+  [[nodiscard]] PredictedEpoch predict(AlignedEpoch epoch) override;
+  [[nodiscard]] UpdatedEpoch update(PredictedEpoch epoch) override;
+  [[nodiscard]] SolvedEpoch resolve(UpdatedEpoch epoch) override;
   void finish() override { engine_.flush_alignment(); }
 
  private:
@@ -186,7 +131,7 @@ class FusionEstimator final : public EpochEstimator {
 };
 
 /// Receives each epoch after its last stage (on the ambiguity stage's thread); an error stops the pipeline.
-using EpochSink = std::function<Status(const EpochItem&)>;
+using EpochSink = std::function<Status(const SolvedEpoch&)>;
 /// What a stage's output means to the outside (the rover publishes it on DDS), in two steps, both on the stage's
 /// thread, each once per epoch and stage:
 ///  - taken(stage, item): right after the stage, before the epoch moves on. It delays the epoch: keep it quick (take
@@ -195,8 +140,10 @@ using EpochSink = std::function<Status(const EpochItem&)>;
 ///    after the sink; bridge-ahead: ingest and time bridge once queued, the others after the sink; sequential: after
 ///    the epoch's sink, stage by stage). The place for slow work such as DDS
 ///    writes: it no longer delays this epoch, and in the threaded pipeline it overlaps the next stage.
+///  - solved(epoch): the whole epoch right after the ambiguity stage (after its taken()), before the sink.
 struct StageObserver {
-  std::function<void(Stage, const EpochItem&)> taken;
+  std::function<void(Stage, const IngestedEpoch&)> taken;
+  std::function<void(const SolvedEpoch&)> solved;
   std::function<void(Stage)> handed_on;
 };
 
@@ -248,19 +195,33 @@ class EpochPipeline {
   Status run_sequential();
   Status run_bridge_ahead();
   Status run_threaded();
+  /// A middle stage's thread of the threaded layout: `step` on each epoch from `in`, its output to `out`.
+  template <typename In, typename Out, typename Step>
+  void stage_thread(Stage stage, core::SpscHandoff<std::optional<In>>& in, core::SpscHandoff<std::optional<Out>>& out,
+                    Step step);
   /// Restricts the calling thread to `stage`'s CPUs, if it has any (a refusal by the kernel fails the run).
   void pin(Stage stage);
   /// The ingest stage's bookkeeping for an epoch the source returned: sequence number, arrival and exit times.
-  void ingested(EpochItem& item, std::uint64_t seq, std::int64_t enter_ns);
-  /// The ingest stage of the threaded layouts: the source's next epoch, stamped (ingested()); nullptr at the end of
+  void ingested(IngestedEpoch& epoch, std::uint64_t seq, std::int64_t enter_ns);
+  /// The ingest stage of the threaded layouts: the source's next epoch, stamped (ingested()); nullopt at the end of
   /// the input, or after the source's error (recorded by fail()).
-  std::unique_ptr<EpochItem> ingest_next(std::uint64_t seq);
-  void run_stage(Stage stage, EpochItem& item);
+  std::optional<IngestedEpoch> ingest_next(std::uint64_t seq);
+  // The stages after ingest, each timed in the epoch's clock and observed (taken(); resolve() also solved()).
+  BridgedEpoch bridge(IngestedEpoch epoch);
+  AlignedEpoch align(BridgedEpoch epoch);
+  PredictedEpoch predict(AlignedEpoch epoch);
+  UpdatedEpoch update(PredictedEpoch epoch);
+  SolvedEpoch resolve(UpdatedEpoch epoch);
+  /// Runs `step` on `in` as `stage`: its enter and exit times in the epoch's clock, then taken().
+  template <typename Out, typename In, typename Step>
+  Out timed(Stage stage, In in, Step step);
+  /// An epoch past the last stage: counted and sunk (unless the pipeline failed); an error of the sink fails it.
+  void sink(const SolvedEpoch& epoch);
   void handed_on(Stage stage) const {
     if (observer_.handed_on) observer_.handed_on(stage);
   }
-  /// Waits until every epoch before `item` has left the last stage, then hands its ephemerides to the estimator.
-  void add_navigation(const EpochItem& item);
+  /// Waits until every epoch before `epoch` has left the last stage, then hands its ephemerides to the estimator.
+  void add_navigation(const IngestedEpoch& epoch);
   void fail(const Error& error);
 
   EpochSource& source_;

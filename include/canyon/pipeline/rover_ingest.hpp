@@ -4,7 +4,7 @@
 // pace, serial, TCP, NTRIP); base epochs from a RINEX file (BaseCursor) or from RTCM 3 that streams in
 // (LiveBaseCursor: frames from DDS, handed in by the caller, or bytes from a ByteLink, NTRIP or TCP). Ephemerides
 // that arrive on the streams (SFRBX, RTCM 1019/1020/1042/1045/1046) travel with the epoch they arrived before
-// (EpochItem::navigation) and are added to the estimator's store by EphemerisFeed when the pipeline has drained
+// (IngestedEpoch::navigation) and are added to the estimator's store by EphemerisFeed when the pipeline has drained
 // the epochs before (EpochPipeline): the threaded and the sequential pipeline use the same ephemerides for the same
 // epoch.
 //
@@ -105,9 +105,9 @@ BaseInput::PollFn link_base_poll(std::shared_ptr<ByteLink> link, WarnFn warn);
 struct RoverIngestOptions {
   double pace = 1.0;               ///< rover file replay speed (0: as fast as possible)
   double base_wait_s = 2.0;        ///< a streamed base: how long a rover epoch waits for its base epoch
-  bool stream_ephemerides = true;  ///< hand the streams' ephemerides to the estimator (EpochItem::navigation)
-  /// A streamed base's position from its RTCM 1005/1006 (EpochItem::base_position_E_m); until the first arrives, the
-  /// rover epochs go on without a base (counted). False: the configured position is used, the stream's ignored.
+  bool stream_ephemerides = true;  ///< hand the streams' ephemerides to the estimator (IngestedEpoch::navigation)
+  /// A streamed base's position from its RTCM 1005/1006 (IngestedEpoch::base_position_E_m); until the first arrives,
+  /// the rover epochs go on without a base (counted). False: the configured position is used, the stream's ignored.
   bool base_position_from_stream = false;
 };
 
@@ -115,7 +115,7 @@ class RoverIngest final : public EpochSource {
  public:
   RoverIngest(RoverInput rover, BaseInput base, RoverIngestOptions options, StopFn stopped, WarnFn warn);
 
-  Result<std::optional<EpochItem>> next() override;
+  Result<std::optional<IngestedEpoch>> next() override;
 
   /// Rover epochs that went on without waiting longer for their base (streamed base).
   [[nodiscard]] std::uint64_t base_late() const { return base_late_.load(); }
@@ -138,12 +138,12 @@ class RoverIngest final : public EpochSource {
   Result<std::optional<core::ObsEpoch>> next_rover();
   /// Sleeps until the rover epoch at t is due at the replay pace; false if stopped meanwhile.
   bool wait_until_due(const core::GpsTime& t);
-  Status attach_base(EpochItem& item);
+  Status attach_base(IngestedEpoch& item);
   /// The stream's base position for the epoch (base_position_from_stream), or no base while there is none.
-  void attach_base_position(EpochItem& item);
-  void attach_navigation(EpochItem& item);
-  /// The streams' loss counts so far (EpochItem::rover_link, base_link).
-  void attach_link_counts(EpochItem& item) const;
+  void attach_base_position(IngestedEpoch& item);
+  void attach_navigation(IngestedEpoch& item);
+  /// The streams' loss counts so far (IngestedEpoch::rover_link, base_link).
+  void attach_link_counts(IngestedEpoch& item) const;
 
   RoverInput rover_;
   BaseInput base_;
@@ -164,11 +164,11 @@ class RoverIngest final : public EpochSource {
 class EphemerisFeed final : public EpochEstimator {
  public:
   EphemerisFeed(EpochEstimator& inner, gnss::EphemerisStore& store) : inner_(inner), store_(store) {}
-  void bridge(EpochItem& item) const override { inner_.bridge(item); }
-  void align(EpochItem& item) override { inner_.align(item); }
-  void predict(EpochItem& item) override { inner_.predict(item); }
-  void update(EpochItem& item) override { inner_.update(item); }
-  void resolve(EpochItem& item) override { inner_.resolve(item); }
+  [[nodiscard]] BridgedEpoch bridge(IngestedEpoch epoch) const override { return inner_.bridge(std::move(epoch)); }
+  [[nodiscard]] AlignedEpoch align(BridgedEpoch epoch) override { return inner_.align(std::move(epoch)); }
+  [[nodiscard]] PredictedEpoch predict(AlignedEpoch epoch) override { return inner_.predict(std::move(epoch)); }
+  [[nodiscard]] UpdatedEpoch update(PredictedEpoch epoch) override { return inner_.update(std::move(epoch)); }
+  [[nodiscard]] SolvedEpoch resolve(UpdatedEpoch epoch) override { return inner_.resolve(std::move(epoch)); }
   void finish() override { inner_.finish(); }
   void add_navigation(const core::NavigationData& fresh) override;
   /// Ephemeris records added so far.
