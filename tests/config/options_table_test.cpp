@@ -1,0 +1,145 @@
+// The descriptor layer (options_table.hpp) on a small struct: one table reads, prints, compares and describes it.
+
+#include "canyon/config/options_table.hpp"
+
+#include <cmath>
+#include <functional>
+#include <optional>
+
+#include <gtest/gtest.h>
+
+namespace canyon::config {
+namespace {
+
+struct Inner {
+  double gain_db = 2.0;
+  int count = 3;
+};
+
+struct Toy {
+  enum class Mode { Fast, Careful };
+  double mask_rad = 15.0 * 0.017453292519943295;
+  Mode mode = Mode::Fast;
+  Inner inner;
+  std::optional<Eigen::Vector3d> where_m;
+  std::vector<std::string> files;
+  std::size_t queue = 8;
+  double scratch = 0.0;  ///< not a key: neither read, printed nor compared
+};
+
+const Table<Inner>& inner_table() {
+  static const Table<Inner> table{{"count", "", "how many", at(&Inner::count)}};
+  return table;
+}
+
+const Table<Toy>& toy_table() {
+  static const Table<Toy> table{
+      {"mask_deg", "deg", "elevation mask", at(&Toy::mask_rad), Degrees{}},
+      {"mode", "", "fast | careful", at(&Toy::mode),
+       Names<Toy::Mode>{{{Toy::Mode::Fast, "fast"}, {Toy::Mode::Careful, "careful"}}}},
+      {"gain_db", "dB", "a nested member, flat in YAML", at(&Toy::inner, &Inner::gain_db)},
+      {"where_m", "m", "optional position", at(&Toy::where_m), Optional<Vector3>{}},
+      {"files", "", "paths relative to the file", at(&Toy::files), Paths{}},
+      {"queue", "", "a count", at(&Toy::queue), Count{}},
+      {"inner", "a section", at(&Toy::inner), inner_table()},
+  };
+  return table;
+}
+
+Result<Toy> read_toy(const std::string& yaml, const std::string& file = "/cfg/toy.yaml") {
+  Toy toy;
+  YamlMap map(YAML::Load(yaml), file);
+  read_keys(toy_table(), map, toy);
+  if (Status s = map.status(); !s) return s.error();
+  return toy;
+}
+
+TEST(OptionsTable, ReadsMembersThroughTheirPathsAndConversions) {
+  auto toy = read_toy("mask_deg: 12.3\nmode: careful\ngain_db: -1.5\nfiles: [a.nav, /abs/b.nav]\ninner: {count: 7}\n");
+  ASSERT_TRUE(toy) << toy.error().to_string();
+  EXPECT_EQ(toy->mask_rad, 12.3 * core::kDegToRad);  // bit for bit: deg * kDegToRad
+  EXPECT_EQ(toy->mode, Toy::Mode::Careful);
+  EXPECT_EQ(toy->inner.gain_db, -1.5);
+  EXPECT_EQ(toy->inner.count, 7);
+  EXPECT_EQ(toy->files, (std::vector<std::string>{"/cfg/a.nav", "/abs/b.nav"}));
+  EXPECT_FALSE(toy->where_m.has_value());
+  // Absent keys keep the member; an angle goes through degrees and back, as parse_angle_deg did.
+  auto defaults = read_toy("{}");
+  ASSERT_TRUE(defaults);
+  EXPECT_EQ(defaults->mask_rad, Toy{}.mask_rad * core::kRadToDeg * core::kDegToRad);
+  EXPECT_EQ(defaults->queue, 8U);
+  auto where = read_toy("where_m: [1, 2, 3]\nqueue: -4\n");
+  ASSERT_TRUE(where);
+  ASSERT_TRUE(where->where_m.has_value());
+  EXPECT_EQ(where->where_m->z(), 3.0);
+  EXPECT_EQ(where->queue, 0U);
+}
+
+TEST(OptionsTable, UnknownKeysAndBadValuesNameTheFileTheLineAndTheKeyPath) {
+  const auto error = [](const std::string& yaml) { return read_toy(yaml, "toy.yaml").error(); };
+  const Error unknown = error("mode: fast\ninner:\n  count: 1\n  cuont: 2\n");
+  EXPECT_EQ(unknown.message, "unknown key 'inner.cuont'");
+  EXPECT_EQ(unknown.file, "toy.yaml");
+  EXPECT_EQ(unknown.line, 4);
+  EXPECT_EQ(error("gain_db: 1\nmode: quick\n").message, "'mode' must be fast or careful, not 'quick'");
+  EXPECT_EQ(error("mode: quick\n").line, 1);
+  EXPECT_EQ(error("where_m: [1, 2]\n").message, "'where_m' must be [x, y, z]");
+  EXPECT_EQ(error("mask_deg: high\n").message, "'mask_deg' must be a number");
+}
+
+TEST(OptionsTable, PrintsInTableOrderAndReadsBackEqual) {
+  Toy toy;
+  toy.mode = Toy::Mode::Careful;
+  toy.files = {"a.nav"};
+  EXPECT_EQ(yaml_text(toy_table(), toy, Numbers::Digits12),
+            "mask_deg: 15\nmode: careful\ngain_db: 2\nfiles: [a.nav]\nqueue: 8\ninner:\n  count: 3\n");
+  toy.where_m = Eigen::Vector3d(0.1, 0.2, 1.0 / 3.0);
+  const std::string twelve = yaml_text(toy_table(), toy, Numbers::Digits12);
+  EXPECT_NE(twelve.find("where_m: [0.1, 0.2, 0.333333333333]\n"), std::string::npos) << twelve;
+  const std::string shortest = yaml_text(toy_table(), toy, Numbers::Shortest);
+  EXPECT_NE(shortest.find("where_m: [0.1, 0.2, 0.3333333333333333]\n"), std::string::npos) << shortest;
+  auto again = read_toy(shortest, "");
+  ASSERT_TRUE(again) << again.error().to_string();
+  EXPECT_TRUE(equal_keys(toy_table(), *again, toy));
+}
+
+TEST(OptionsTable, ComparesKeyByKey) {
+  // One change per key of the table: each must make the structs differ; a member that is no key must not.
+  const std::vector<std::function<void(Toy&)>> changes{
+      [](Toy& t) { t.mask_rad = std::nextafter(t.mask_rad, 1.0); },
+      [](Toy& t) { t.mode = Toy::Mode::Careful; },
+      [](Toy& t) { t.inner.gain_db = 2.5; },
+      [](Toy& t) { t.where_m = Eigen::Vector3d::Zero(); },
+      [](Toy& t) { t.files.emplace_back("x"); },
+      [](Toy& t) { t.queue = 9; },
+      [](Toy& t) { t.inner.count = 4; },
+  };
+  ASSERT_EQ(changes.size(), describe_keys(toy_table(), Toy{}, Numbers::Digits12).size());
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    Toy changed;
+    changes[i](changed);
+    EXPECT_FALSE(equal_keys(toy_table(), Toy{}, changed)) << "change " << i;
+  }
+  Toy scratch;
+  scratch.scratch = 1.0;
+  EXPECT_TRUE(equal_keys(toy_table(), Toy{}, scratch));
+}
+
+TEST(OptionsTable, DescribesEveryKeyWithUnitDefaultAndDoc) {
+  const auto keys = describe_keys(toy_table(), Toy{}, Numbers::Digits12);
+  ASSERT_EQ(keys.size(), 7U);
+  EXPECT_EQ(keys[0].path, "mask_deg");
+  EXPECT_EQ(keys[0].unit, "deg");
+  EXPECT_EQ(keys[0].default_value, "15");
+  EXPECT_EQ(keys[0].doc, "elevation mask");
+  EXPECT_EQ(keys[2].path, "gain_db");
+  EXPECT_EQ(keys[3].default_value, "");  // unset optional
+  EXPECT_EQ(keys[4].default_value, "[]");
+  EXPECT_EQ(keys[6].path, "inner.count");
+  const std::string text = format_descriptions(keys);
+  EXPECT_NE(text.find("mask_deg     deg   15       elevation mask\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("where_m      m     (unset)  optional position\n"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace canyon::config
