@@ -1,6 +1,8 @@
 #pragma once
 // Configuration of `canyon process`: inputs, mode, output format and the estimator options, from a strict YAML
-// file and/or the command line. Relative paths in a YAML file are relative to that file's folder.
+// file and/or the command line. Relative paths in a YAML file are relative to that file's folder. Every key is
+// described once, in the tables below (process_config.cpp, estimator_tables.cpp): they parse, print and compare the
+// configuration, and `canyon process --describe-config` lists every key with its unit, default and doc.
 //
 // YAML keys (all optional; the command line overrides them):
 //   mode: spp                      # processing mode: spp | rtk | fusion
@@ -36,6 +38,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "canyon/config/options_table.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/fusion/fusion_options.hpp"
 #include "canyon/gnss/spp.hpp"
@@ -71,6 +74,7 @@ struct ProcessConfig {
   [[nodiscard]] rtk::RtkOptions rtk_engine_options() const;
 };
 
+/// Equal when every key of the tables is (the member itself where it can be compared, else its YAML form).
 [[nodiscard]] bool operator==(const ProcessConfig& a, const ProcessConfig& b);
 
 /// Parses a YAML node; `file` names the source in errors and anchors relative paths.
@@ -81,5 +85,14 @@ Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig
 [[nodiscard]] std::string to_yaml(const ProcessConfig& config);
 
 [[nodiscard]] std::string mode_name(ProcessMode mode);
+
+/// The keys of each section (options_table.hpp): spp:, rtk:, fusion: (flat keys over the per-piece structs), and the
+/// whole configuration with those as sections.
+[[nodiscard]] const Table<gnss::SppOptions>& spp_table();
+[[nodiscard]] const Table<rtk::RtkOptions>& rtk_table();
+[[nodiscard]] const Table<fusion::FusionOptions>& fusion_table();
+[[nodiscard]] const Table<ProcessConfig>& process_table();
+/// Every key with its unit, default (of ProcessConfig{}) and doc.
+[[nodiscard]] std::vector<KeyDescription> describe_process_config();
 
 }  // namespace canyon::config
