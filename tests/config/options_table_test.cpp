@@ -1,12 +1,20 @@
-// The descriptor layer (options_table.hpp) on a small struct: one table reads, prints, compares and describes it.
+// The descriptor layer (options_table.hpp) on a small struct: one table reads, prints, compares and describes it;
+// then the real tables: degrees read bit for bit as before, comparison key by key (not by printed text), and
+// describe_*() defaults that read back as the defaults.
 
 #include "canyon/config/options_table.hpp"
 
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <set>
 
 #include <gtest/gtest.h>
+
+#include "canyon/config/base_config.hpp"
+#include "canyon/config/process_config.hpp"
+#include "canyon/config/rover_config.hpp"
+#include "canyon/config/scenario_config.hpp"
 
 namespace canyon::config {
 namespace {
@@ -139,6 +147,104 @@ TEST(OptionsTable, DescribesEveryKeyWithUnitDefaultAndDoc) {
   const std::string text = format_descriptions(keys);
   EXPECT_NE(text.find("mask_deg     deg   15       elevation mask\n"), std::string::npos) << text;
   EXPECT_NE(text.find("where_m      m     (unset)  optional position\n"), std::string::npos) << text;
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The real tables.
+
+TEST(OptionsTables, AnglesReadBitForBitAsBefore) {
+  auto config =
+      parse_process_config(YAML::Load("rtk: {elevation_mask_deg: 12.3}\nspp: {elevation_mask_deg: 7.7}\n"), "");
+  ASSERT_TRUE(config) << config.error().to_string();
+  EXPECT_EQ(config->rtk.elevation_mask_rad, 12.3 * core::kDegToRad);
+  EXPECT_EQ(config->spp.elevation_mask_rad, 7.7 * core::kDegToRad);
+  // An absent angle goes through degrees and back: (rad * kRadToDeg) * kDegToRad.
+  EXPECT_EQ(config->rtk.ar_elevation_mask_rad,
+            rtk::RtkOptions{}.ar_elevation_mask_rad * core::kRadToDeg * core::kDegToRad);
+  // Printed as today: degrees at 12 digits.
+  EXPECT_NE(to_yaml(*config).find("  elevation_mask_deg: 12.3\n"), std::string::npos);
+}
+
+TEST(OptionsTables, ComparisonIsByKeyNotByPrintedText) {
+  ProcessConfig a;
+  ProcessConfig b;
+  b.rtk.elevation_mask_rad = std::nextafter(a.rtk.elevation_mask_rad, 1.0);
+  EXPECT_EQ(to_yaml(a), to_yaml(b));  // 12 digits cannot show it
+  EXPECT_FALSE(a == b);
+  b = a;
+  b.fusion.alignment.fit.max_rmse_m = 0.2;  // a nested fusion member, flat under fusion:
+  EXPECT_FALSE(a == b);
+  b = a;
+  b.spp.max_iterations = 99;  // not a key: not compared
+  EXPECT_TRUE(a == b);
+  sim::Scenario s;
+  sim::Scenario t;
+  t.source_file = "elsewhere.yaml";
+  EXPECT_TRUE(same_scenario(s, t));
+  t.base_receiver.clock_drift_noise *= 1.0 + 1e-15;
+  EXPECT_FALSE(same_scenario(s, t));
+}
+
+/// A YAML document setting every described key to its described default.
+YAML::Node document_of(const std::vector<KeyDescription>& keys) {
+  YAML::Node root(YAML::NodeType::Map);
+  for (const KeyDescription& k : keys) {
+    if (k.default_value.empty()) continue;  // unset optional
+    YAML::Node node = root;
+    std::string path = k.path;
+    for (std::size_t dot = path.find('.'); dot != std::string::npos; dot = path.find('.')) {
+      node.reset(node[path.substr(0, dot)]);
+      path = path.substr(dot + 1);
+    }
+    node[path] = YAML::Load(k.default_value);
+  }
+  return root;
+}
+
+template <typename Describe>
+void expect_unique_paths(const Describe& keys) {
+  std::set<std::string> paths;
+  for (const KeyDescription& k : keys) EXPECT_TRUE(paths.insert(k.path).second) << k.path;
+  for (const KeyDescription& k : keys) EXPECT_FALSE(k.doc.empty()) << k.path;
+}
+
+TEST(OptionsTables, DescribedDefaultsReadBackAsTheDefaults) {
+  const auto process = describe_process_config();
+  expect_unique_paths(process);
+  auto p = parse_process_config(document_of(process), "");
+  ASSERT_TRUE(p) << p.error().to_string();
+  EXPECT_TRUE(*p == ProcessConfig{});
+  const auto rover = describe_rover_config();
+  expect_unique_paths(rover);
+  auto r = parse_rover_config(document_of(rover), "");
+  ASSERT_TRUE(r) << r.error().to_string();
+  EXPECT_TRUE(*r == RoverConfig{});
+  const auto base = describe_base_config();
+  expect_unique_paths(base);
+  auto b = parse_base_config(document_of(base), "");
+  ASSERT_TRUE(b) << b.error().to_string();
+  EXPECT_TRUE(*b == BaseConfig{});
+  const auto scenario = describe_scenario();
+  expect_unique_paths(scenario);
+  auto s = parse_scenario(document_of(scenario), "");
+  ASSERT_TRUE(s) << s.error().to_string();
+  EXPECT_TRUE(same_scenario(*s, sim::Scenario{}));
+  // A few entries as a user sees them.
+  const auto find = [](const std::vector<KeyDescription>& keys, const std::string& path) {
+    for (const KeyDescription& k : keys) {
+      if (k.path == path) return k;
+    }
+    return KeyDescription{};
+  };
+  EXPECT_EQ(find(process, "rtk.elevation_mask_deg").unit, "deg");
+  EXPECT_EQ(find(process, "rtk.elevation_mask_deg").default_value, "15");
+  EXPECT_EQ(find(process, "fusion.alignment_max_rmse_m").default_value, "0.1");
+  EXPECT_EQ(find(process, "fusion.gate").default_value, "both");
+  EXPECT_EQ(find(process, "rtk.glonass_ar").default_value, "off");
+  EXPECT_EQ(find(process, "base_position").default_value, "");
+  EXPECT_EQ(find(rover, "estimator.rtk.ar_mode").default_value, "continuous");
+  EXPECT_EQ(find(base, "outputs.ntrip.port").default_value, "2101");
+  EXPECT_EQ(find(scenario, "base_receiver.elevation_cutoff_deg").default_value, "5");
 }
 
 }  // namespace
