@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 
 namespace canyon::config {
@@ -16,9 +17,15 @@ std::string resolve_path(const std::string& path, const std::string& file) {
 
 std::string shortest_number(double value) {
   char buffer[40];
-  for (int precision = 1; precision <= 17; ++precision) {
+  int precision = 1;
+  for (; precision <= 17; ++precision) {
     std::snprintf(buffer, sizeof buffer, "%.*g", precision, value);
     if (std::strtod(buffer, nullptr) == value) break;
+  }
+  // %g writes 600 as 6e+02 at one digit: more digits, until the integer part is written out (up to 17). A correctly
+  // rounded decimal with more digits is at least as close to the value, so it still reads back the same.
+  while (std::strstr(buffer, "e+") != nullptr && precision < 17) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", ++precision, value);
   }
   return buffer;
 }

@@ -5,8 +5,10 @@
 #include "canyon/config/options_table.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <optional>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -109,6 +111,25 @@ TEST(OptionsTable, PrintsInTableOrderAndReadsBackEqual) {
   auto again = read_toy(shortest, "");
   ASSERT_TRUE(again) << again.error().to_string();
   EXPECT_TRUE(equal_keys(toy_table(), *again, toy));
+}
+
+TEST(OptionsTable, ShortestNumbersReadBackTheSame) {
+  EXPECT_EQ(shortest_number(600.0), "600");
+  EXPECT_EQ(shortest_number(20000.0), "20000");
+  EXPECT_EQ(shortest_number(-1234.5), "-1234.5");
+  EXPECT_EQ(shortest_number(0.1), "0.1");
+  EXPECT_EQ(shortest_number(5e-8), "5e-08");
+  EXPECT_EQ(shortest_number(1.0 / 3.0), "0.3333333333333333");
+  EXPECT_EQ(shortest_number(1e20), "1e+20");
+  EXPECT_EQ(shortest_number(0.0), "0");
+  // Random doubles over many magnitudes read back bit for bit.
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> mantissa(-10.0, 10.0);
+  std::uniform_int_distribution<int> exponent(-30, 30);
+  for (int i = 0; i < 20000; ++i) {
+    const double v = mantissa(random) * std::pow(10.0, exponent(random));
+    EXPECT_EQ(std::strtod(shortest_number(v).c_str(), nullptr), v) << shortest_number(v);
+  }
 }
 
 TEST(OptionsTable, ComparesKeyByKey) {

@@ -61,7 +61,7 @@ struct KeyDescription {
 /// `path` relative to the folder of the YAML `file` it was read from (absolute paths, and "" stay as they are).
 [[nodiscard]] std::string resolve_path(const std::string& path, const std::string& file);
 
-/// The shortest decimal text that reads back as the same double.
+/// The shortest decimal text that reads back as the same double, its integer part written out (600, not 6e+02).
 [[nodiscard]] std::string shortest_number(double value);
 
 /// A codec's view of the key it reads: a failure is recorded in the map, naming the file, the line and the key path.
