@@ -24,7 +24,8 @@ Table<O> rtk_selection_and_ar_keys() {
        at(&O::observables, &Obs::num_frequencies)},
       {"systems", "", "constellations used: G GPS, R GLONASS, E Galileo, C BeiDou, J QZSS", at(&O::observables),
        Systems{}},
-      {"exclude", "", "satellites never used, e.g. [G05, E11]", at(&O::observables, &Obs::excluded), Satellites{}},
+      {"exclude", "", "satellites never used, e.g. [G05, E11] (also those of spp.exclude)",
+       at(&O::observables, &Obs::excluded), Satellites{}},
       {"elevation_mask_deg", "deg", "satellites below are not used", at(&O::elevation_mask_rad), Degrees{}},
       {"ar_elevation_mask_deg", "deg", "ambiguities of satellites below are not fixed", at(&O::ar_elevation_mask_rad),
        Degrees{}},
@@ -260,7 +261,8 @@ const Table<gnss::SppOptions>& spp_table() {
       {"raim_fde", "", "exclude one faulty satellite when the residual chi-square test fails", at(&S::raim_fde)},
       {"max_gdop", "", "epochs with a larger GDOP get no solution", at(&S::max_gdop)},
       {"qzss_own_clock", "", "false: QZSS shares the GPS receiver clock", at(&S::qzss_own_clock)},
-      {"exclude", "", "satellites never used, e.g. [G05, R12]", at(&S::excluded), Satellites{}},
+      {"exclude", "", "satellites never used, e.g. [G05, R12] (also those of rtk.exclude)", at(&S::excluded),
+       Satellites{}},
   };
   return table;
 }
