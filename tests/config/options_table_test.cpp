@@ -184,6 +184,13 @@ TEST(OptionsTables, AnglesReadBitForBitAsBefore) {
             rtk::RtkOptions{}.ar_elevation_mask_rad * core::kRadToDeg * core::kDegToRad);
   // Printed as today: degrees at 12 digits.
   EXPECT_NE(to_yaml(*config).find("  elevation_mask_deg: 12.3\n"), std::string::npos);
+  // Every tenth of a degree: another arithmetic (deg / kRadToDeg, deg * kPi / 180) differs on some of them.
+  for (int tenths = 0; tenths < 900; ++tenths) {
+    const std::string deg = std::to_string(tenths / 10) + "." + std::to_string(tenths % 10);
+    auto c = parse_process_config(YAML::Load("rtk: {elevation_mask_deg: " + deg + "}\n"), "");
+    ASSERT_TRUE(c) << c.error().to_string();
+    ASSERT_EQ(c->rtk.elevation_mask_rad, std::stod(deg) * core::kDegToRad) << deg;
+  }
 }
 
 TEST(OptionsTables, ComparisonIsByKeyNotByPrintedText) {
