@@ -19,7 +19,9 @@
 #include "canyon/commands/evaluate.hpp"
 #include "canyon/commands/process.hpp"
 #include "canyon/commands/simulate.hpp"
+#include "canyon/config/base_config.hpp"
 #include "canyon/config/process_config.hpp"
+#include "canyon/config/rover_config.hpp"
 #include "canyon/config/scenario_config.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/satellite.hpp"
@@ -73,6 +75,8 @@ struct ProcessArgs {
   std::string time_format;
   double elevation_mask_deg = -1.0;
   bool print_config = false;
+  CLI::Option* describe_config = nullptr;  ///< given: print the keys of describe_what's configuration
+  std::string describe_what;               ///< process (also when empty), rover, base or scenario
   bool quiet = false;
   bool verbose = false;
   std::string pipeline = "bridge-ahead";
@@ -103,6 +107,12 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   cmd->add_option("--elevation-mask-deg", args.elevation_mask_deg, "Elevation mask (deg), default 15")
       ->check(CLI::Range(0.0, 89.9));
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
+  args.describe_config =
+      cmd->add_option("--describe-config", args.describe_what,
+                      "Print every configuration key with its unit, default and meaning, and exit: of canyon process "
+                      "(the default), or of rover, base or a simulation scenario")
+          ->expected(0, 1)
+          ->check(CLI::IsMember({"process", "rover", "base", "scenario"}));
   cmd->add_option("--pipeline", args.pipeline,
                   "rtk and fusion: run the six stages bridge-ahead (the default: ingest and the time bridge on a "
                   "second thread, ahead of the other four), sequential (one thread) or threaded (six threads and "
@@ -124,8 +134,30 @@ void print_warnings(const std::vector<std::string>& warnings, bool verbose, cons
   }
 }
 
+/// --describe-config [WHAT]: the keys of a configuration, from the tables that parse it.
+int print_key_descriptions(const std::string& what) {
+  namespace config = canyon::config;
+  if (what == "rover") {
+    std::cout << "# canyon rover --config FILE: every key (strict YAML; estimator: holds canyon process's keys)\n"
+              << config::format_descriptions(config::describe_rover_config());
+  } else if (what == "base") {
+    std::cout << "# canyon base --config FILE: every key (strict YAML)\n"
+              << config::format_descriptions(config::describe_base_config());
+  } else if (what == "scenario") {
+    std::cout << "# canyon simulate --scenario FILE.yaml: every key (strict YAML)\n"
+              << config::format_descriptions(config::describe_scenario());
+  } else {
+    std::cout << "# canyon process --config FILE: every key (strict YAML; the command line overrides the file)\n"
+              << config::format_descriptions(config::describe_process_config());
+  }
+  return 0;
+}
+
 int run_process_command(const ProcessArgs& args) {
   using canyon::config::ProcessConfig;
+  if (args.describe_config != nullptr && args.describe_config->count() > 0) {
+    return print_key_descriptions(args.describe_what);
+  }
   ProcessConfig config;
   if (!args.config_file.empty()) {
     auto loaded = canyon::config::load_process_config(args.config_file);

@@ -1,20 +1,16 @@
-// `canyon base` configuration: strict YAML parsing, printing and validation.
+// `canyon base` configuration: its keys described once (config/base.yaml shows each with its unit), parsed, printed
+// and compared from that description; validation.
 
 #include "canyon/config/base_config.hpp"
 
 #include <cstdio>
-#include <filesystem>
 
-#include "canyon/config/yaml_reader.hpp"
 #include "canyon/core/time.hpp"
 
 namespace canyon::config {
 namespace {
 
-std::string resolve(const std::string& path, const std::string& file) {
-  if (path.empty() || file.empty() || std::filesystem::path(path).is_absolute()) return path;
-  return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
-}
+using B = BaseConfig;
 
 std::string format_gps(const core::GpsTime& t) {
   const core::CalendarTime c = core::gps_to_calendar(t);
@@ -24,7 +20,146 @@ std::string format_gps(const core::GpsTime& t) {
   return text;
 }
 
+/// input.approx_time: "YYYY-MM-DD HH:MM:SS" (GPST).
+struct GpsCalendar {
+  using Yaml = std::string;
+  [[nodiscard]] std::string to(const core::GpsTime& t) const { return format_gps(t); }
+  void from(const std::string& text, core::GpsTime& t, Reading& reading) const {
+    const auto parsed = core::parse_gps_calendar(text);
+    if (!parsed) {
+      reading.fail("must be 'YYYY-MM-DD HH:MM:SS' (GPST), not '" + text + "'");
+      return;
+    }
+    t = *parsed;
+  }
+};
+
+/// input.path: a file relative to the configuration file's folder (source file), else a serial device as it is.
+struct InputPath {
+  using Yaml = std::string;
+  [[nodiscard]] std::string to(const B::Input& in) const { return in.path; }
+  void from(const std::string& value, B::Input& in, Reading& reading) const {
+    in.path = in.source == BaseInputSource::File ? resolve_path(value, reading.file()) : value;
+  }
+};
+
+const Table<B::Station>& station_table() {
+  using S = B::Station;
+  static const Table<S> table{
+      {"id", "", "RTCM reference station id (DF003), 0-4095", at(&S::id)},
+      {"position", "m", "ARP position, ECEF [X, Y, Z] (1005); default: the input's header, 1005 or first fix",
+       at(&S::position_E_m), Optional<Vector3>{{"must be [X, Y, Z], ECEF metres"}}},
+      {"antenna_height_m", "m", "height of the ARP above the marker (0-6.5535): sends 1006 instead of 1005",
+       at(&S::antenna_height_m), Optional<Same<double>>{}},
+      {"antenna", "", "IGS antenna type for 1033, at most 31 characters (\"\" and receiver \"\": no 1033)",
+       at(&S::antenna)},
+      {"receiver", "", "receiver type for 1033", at(&S::receiver)},
+  };
+  return table;
+}
+
+const Table<B::Input>& input_table() {
+  using I = B::Input;
+  static const Table<I> table{
+      {"kind", "", "rinex | ubx | rtcm3: what the base receiver delivers", at(&I::kind),
+       names_of({BaseInputKind::Rinex, BaseInputKind::Ubx, BaseInputKind::Rtcm3}, input_kind_name)},
+      {"source", "", "file | serial | tcp | ntrip (rinex: file only)", at(&I::source),
+       names_of({BaseInputSource::File, BaseInputSource::Serial, BaseInputSource::Tcp, BaseInputSource::Ntrip},
+                input_source_name)},
+      {"path", "", "file (may be .gz) or serial device (/dev/ttyACM0)", whole, InputPath{}},
+      {"nav", "", "rinex: navigation files whose ephemerides are sent", at(&I::nav), Paths{}},
+      {"pace", "", "file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible", at(&I::pace)},
+      {"approx_time", "", "rtcm3 input: GPST within a few days of the data (default: the clock)", at(&I::approx_time),
+       Optional<GpsCalendar>{}},
+      {"baud", "", "serial: 9600 ... 921600", at(&I::baud)},
+      {"host", "", "tcp / ntrip source: host name or address", at(&I::host)},
+      {"port", "", "tcp / ntrip source: port", at(&I::port)},
+      {"mountpoint", "", "ntrip source: mount point", at(&I::mountpoint)},
+      {"user", "", "ntrip source: Basic authentication (\"\": none)", at(&I::user)},
+      {"password", "", "ntrip source: its password", at(&I::password)},
+  };
+  return table;
+}
+
+const Table<B::Rtcm>& rtcm_table() {
+  using R = B::Rtcm;
+  static const Table<R> table{
+      {"msm", "", "7 (MSM7: full resolution, Doppler) or 4 (MSM4: compact); 5 and 6 accepted", at(&R::msm)},
+      {"station_interval_s", "s", "1005/1006 (and 1033) every this many seconds of data; 0: once at the start",
+       at(&R::station_interval_s)},
+      {"ephemeris_interval_s", "s", "each current ephemeris again every this many seconds; 0: only when new",
+       at(&R::ephemeris_interval_s)},
+  };
+  return table;
+}
+
+const Table<B::Dds>& dds_table() {
+  using D = B::Dds;
+  static const Table<D> table{
+      {"enabled", "", "publish every frame as canyon::msg::RtcmFrame", at(&D::enabled)},
+      {"domain", "", "DDS domain id, 0-232", at(&D::domain)},
+      {"topic", "", "topic name", at(&D::topic)},
+      {"profiles", "", "Fast DDS XML profiles (\"\": the shipped config/dds/canyon_profiles.xml)", at(&D::profiles),
+       Path{}},
+  };
+  return table;
+}
+
+const Table<B::Ntrip>& ntrip_table() {
+  using N = B::Ntrip;
+  static const Table<N> table{
+      {"enabled", "", "NTRIP caster (versions 1 and 2) with the source table", at(&N::enabled)},
+      {"bind", "", "address to listen on", at(&N::bind)},
+      {"port", "", "TCP port (0: any free port, logged)", at(&N::port)},
+      {"mountpoint", "", "mount point name (no ' ', '/', ';')", at(&N::mountpoint)},
+      {"user", "", "Basic authentication of clients (\"\" and password \"\": none)", at(&N::user)},
+      {"password", "", "its password", at(&N::password)},
+  };
+  return table;
+}
+
+const Table<B::Tcp>& tcp_table() {
+  using T = B::Tcp;
+  static const Table<T> table{
+      {"enabled", "", "plain TCP server: every client gets the raw RTCM 3 stream", at(&T::enabled)},
+      {"bind", "", "address to listen on", at(&T::bind)},
+      {"port", "", "TCP port (0: any free port, logged)", at(&T::port)},
+  };
+  return table;
+}
+
+const Table<B>& outputs_table() {
+  static const Table<B> table{
+      {"dds", "the DDS topic", at(&B::dds), dds_table()},
+      {"ntrip", "the NTRIP caster", at(&B::ntrip), ntrip_table()},
+      {"tcp", "the plain TCP server", at(&B::tcp), tcp_table()},
+  };
+  return table;
+}
+
+const Table<B>& log_table() {
+  static const Table<B> table{
+      {"progress_interval_s", "s", "a progress line every this many seconds; 0: none", at(&B::progress_interval_s)},
+  };
+  return table;
+}
+
 }  // namespace
+
+const Table<BaseConfig>& base_table() {
+  static const Table<B> table{
+      {"station", "the reference station: id, position, antenna and receiver", at(&B::station), station_table()},
+      {"input", "the base receiver's data: kind, source and where", at(&B::input), input_table()},
+      {"rtcm", "the RTCM 3 messages sent", at(&B::rtcm), rtcm_table()},
+      {"outputs", "where the RTCM 3 stream goes", whole, outputs_table()},
+      {"log", "progress lines", whole, log_table()},
+  };
+  return table;
+}
+
+std::vector<KeyDescription> describe_base_config() {
+  return describe_keys(base_table(), BaseConfig{}, Numbers::Digits12);
+}
 
 std::string input_kind_name(BaseInputKind kind) {
   switch (kind) {
@@ -84,115 +219,13 @@ std::string BaseConfig::validate() const {
 }
 
 bool operator==(const BaseConfig& a, const BaseConfig& b) {
-  return to_yaml(a) == to_yaml(b);
+  return equal_keys(base_table(), a, b);
 }
 
 Result<BaseConfig> parse_base_config(const YAML::Node& node, const std::string& file, BaseConfig defaults) {
   BaseConfig c = std::move(defaults);
   YamlMap top(node, file);
-  {
-    YamlMap s = top.sub("station");
-    s.get("id", c.station.id);
-    if (s.has("position")) {
-      std::vector<double> xyz;
-      s.get("position", xyz);
-      if (xyz.size() != 3) {
-        s.fail("position", "must be [X, Y, Z], ECEF metres");
-      } else {
-        c.station.position_E_m = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
-      }
-    }
-    if (s.has("antenna_height_m")) {
-      double h = 0.0;
-      s.get("antenna_height_m", h);
-      c.station.antenna_height_m = h;
-    }
-    s.get("antenna", c.station.antenna);
-    s.get("receiver", c.station.receiver);
-    s.reject_unknown_keys();
-  }
-  {
-    YamlMap in = top.sub("input");
-    std::string kind = input_kind_name(c.input.kind);
-    in.get("kind", kind);
-    if (kind == "rinex") {
-      c.input.kind = BaseInputKind::Rinex;
-    } else if (kind == "ubx") {
-      c.input.kind = BaseInputKind::Ubx;
-    } else if (kind == "rtcm3") {
-      c.input.kind = BaseInputKind::Rtcm3;
-    } else {
-      in.fail("kind", "must be rinex, ubx or rtcm3, not '" + kind + "'");
-    }
-    std::string source = input_source_name(c.input.source);
-    in.get("source", source);
-    if (source == "file") {
-      c.input.source = BaseInputSource::File;
-    } else if (source == "serial") {
-      c.input.source = BaseInputSource::Serial;
-    } else if (source == "tcp") {
-      c.input.source = BaseInputSource::Tcp;
-    } else if (source == "ntrip") {
-      c.input.source = BaseInputSource::Ntrip;
-    } else {
-      in.fail("source", "must be file, serial, tcp or ntrip, not '" + source + "'");
-    }
-    in.get("path", c.input.path);
-    if (c.input.source == BaseInputSource::File) c.input.path = resolve(c.input.path, file);
-    in.get("nav", c.input.nav);
-    for (std::string& n : c.input.nav) n = resolve(n, file);
-    in.get("pace", c.input.pace);
-    if (in.has("approx_time")) {
-      std::string text;
-      in.get("approx_time", text);
-      c.input.approx_time = core::parse_gps_calendar(text);
-      if (!c.input.approx_time) in.fail("approx_time", "must be 'YYYY-MM-DD HH:MM:SS' (GPST), not '" + text + "'");
-    }
-    in.get("baud", c.input.baud);
-    in.get("host", c.input.host);
-    in.get("port", c.input.port);
-    in.get("mountpoint", c.input.mountpoint);
-    in.get("user", c.input.user);
-    in.get("password", c.input.password);
-    in.reject_unknown_keys();
-  }
-  {
-    YamlMap r = top.sub("rtcm");
-    r.get("msm", c.rtcm.msm);
-    r.get("station_interval_s", c.rtcm.station_interval_s);
-    r.get("ephemeris_interval_s", c.rtcm.ephemeris_interval_s);
-    r.reject_unknown_keys();
-  }
-  {
-    YamlMap out = top.sub("outputs");
-    YamlMap d = out.sub("dds");
-    d.get("enabled", c.dds.enabled);
-    d.get("domain", c.dds.domain);
-    d.get("topic", c.dds.topic);
-    d.get("profiles", c.dds.profiles);
-    c.dds.profiles = resolve(c.dds.profiles, file);
-    d.reject_unknown_keys();
-    YamlMap n = out.sub("ntrip");
-    n.get("enabled", c.ntrip.enabled);
-    n.get("bind", c.ntrip.bind);
-    n.get("port", c.ntrip.port);
-    n.get("mountpoint", c.ntrip.mountpoint);
-    n.get("user", c.ntrip.user);
-    n.get("password", c.ntrip.password);
-    n.reject_unknown_keys();
-    YamlMap t = out.sub("tcp");
-    t.get("enabled", c.tcp.enabled);
-    t.get("bind", c.tcp.bind);
-    t.get("port", c.tcp.port);
-    t.reject_unknown_keys();
-    out.reject_unknown_keys();
-  }
-  {
-    YamlMap l = top.sub("log");
-    l.get("progress_interval_s", c.progress_interval_s);
-    l.reject_unknown_keys();
-  }
-  top.reject_unknown_keys();
+  read_keys(base_table(), top, c);
   if (Status s = top.status(); !s.ok()) return s.error();
   return c;
 }
@@ -204,64 +237,7 @@ Result<BaseConfig> load_base_config(const std::string& path, BaseConfig defaults
 }
 
 std::string to_yaml(const BaseConfig& c) {
-  YAML::Emitter out;
-  out.SetDoublePrecision(12);
-  out << YAML::BeginMap;
-  out << YAML::Key << "station" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "id" << YAML::Value << c.station.id;
-  if (c.station.position_E_m) {
-    out << YAML::Key << "position" << YAML::Value << YAML::Flow << YAML::BeginSeq << c.station.position_E_m->x()
-        << c.station.position_E_m->y() << c.station.position_E_m->z() << YAML::EndSeq;
-  }
-  if (c.station.antenna_height_m) out << YAML::Key << "antenna_height_m" << YAML::Value << *c.station.antenna_height_m;
-  out << YAML::Key << "antenna" << YAML::Value << c.station.antenna;
-  out << YAML::Key << "receiver" << YAML::Value << c.station.receiver;
-  out << YAML::EndMap;
-  out << YAML::Key << "input" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "kind" << YAML::Value << input_kind_name(c.input.kind);
-  out << YAML::Key << "source" << YAML::Value << input_source_name(c.input.source);
-  out << YAML::Key << "path" << YAML::Value << c.input.path;
-  out << YAML::Key << "nav" << YAML::Value << YAML::Flow << c.input.nav;
-  out << YAML::Key << "pace" << YAML::Value << c.input.pace;
-  if (c.input.approx_time) out << YAML::Key << "approx_time" << YAML::Value << format_gps(*c.input.approx_time);
-  out << YAML::Key << "baud" << YAML::Value << c.input.baud;
-  out << YAML::Key << "host" << YAML::Value << c.input.host;
-  out << YAML::Key << "port" << YAML::Value << c.input.port;
-  out << YAML::Key << "mountpoint" << YAML::Value << c.input.mountpoint;
-  out << YAML::Key << "user" << YAML::Value << c.input.user;
-  out << YAML::Key << "password" << YAML::Value << c.input.password;
-  out << YAML::EndMap;
-  out << YAML::Key << "rtcm" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "msm" << YAML::Value << c.rtcm.msm;
-  out << YAML::Key << "station_interval_s" << YAML::Value << c.rtcm.station_interval_s;
-  out << YAML::Key << "ephemeris_interval_s" << YAML::Value << c.rtcm.ephemeris_interval_s;
-  out << YAML::EndMap;
-  out << YAML::Key << "outputs" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "dds" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "enabled" << YAML::Value << c.dds.enabled;
-  out << YAML::Key << "domain" << YAML::Value << c.dds.domain;
-  out << YAML::Key << "topic" << YAML::Value << c.dds.topic;
-  out << YAML::Key << "profiles" << YAML::Value << c.dds.profiles;
-  out << YAML::EndMap;
-  out << YAML::Key << "ntrip" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "enabled" << YAML::Value << c.ntrip.enabled;
-  out << YAML::Key << "bind" << YAML::Value << c.ntrip.bind;
-  out << YAML::Key << "port" << YAML::Value << c.ntrip.port;
-  out << YAML::Key << "mountpoint" << YAML::Value << c.ntrip.mountpoint;
-  out << YAML::Key << "user" << YAML::Value << c.ntrip.user;
-  out << YAML::Key << "password" << YAML::Value << c.ntrip.password;
-  out << YAML::EndMap;
-  out << YAML::Key << "tcp" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "enabled" << YAML::Value << c.tcp.enabled;
-  out << YAML::Key << "bind" << YAML::Value << c.tcp.bind;
-  out << YAML::Key << "port" << YAML::Value << c.tcp.port;
-  out << YAML::EndMap;
-  out << YAML::EndMap;
-  out << YAML::Key << "log" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "progress_interval_s" << YAML::Value << c.progress_interval_s;
-  out << YAML::EndMap;
-  out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  return yaml_text(base_table(), c, Numbers::Digits12);
 }
 
 }  // namespace canyon::config

@@ -1,4 +1,5 @@
-// `canyon rover` configuration (see rover_config.hpp).
+// `canyon rover` configuration (see rover_config.hpp): its keys described once, parsed, printed and compared from
+// that description; validation.
 
 #include "canyon/config/rover_config.hpp"
 
@@ -8,32 +9,12 @@
 #include <filesystem>
 #include <optional>
 
-#include "canyon/config/yaml_reader.hpp"
 #include "canyon/pipeline/cpu_affinity.hpp"
 
 namespace canyon::config {
 namespace {
 
-/// pipeline.cpu_affinity: {STAGE: [CPU, ...]} for any of the six stages, into `pipeline`.
-void read_cpu_affinity(YamlMap map, pipeline::PipelineOptions& pipeline) {
-  for (std::size_t s = 0; s < pipeline::kNumStages; ++s) {
-    const char* name = pipeline::stage_name(static_cast<pipeline::Stage>(s));
-    std::vector<double> numbers;
-    map.get(name, numbers);
-    std::vector<int>& cpus = pipeline.cpu_affinity[s];
-    cpus.clear();
-    for (const double n : numbers) {
-      if (n != std::floor(n) || n < 0.0 || n > pipeline::max_cpu_number()) {
-        map.fail(name, "CPU numbers are integers in 0.." + std::to_string(pipeline::max_cpu_number()));
-        break;
-      }
-      cpus.push_back(static_cast<int>(n));
-    }
-    std::sort(cpus.begin(), cpus.end());
-    cpus.erase(std::unique(cpus.begin(), cpus.end()), cpus.end());
-  }
-  map.reject_unknown_keys();
-}
+using R = RoverConfig;
 
 constexpr std::array<std::pair<RoverBaseSource, const char*>, 4> kBaseSources{{
     {RoverBaseSource::File, "file"},
@@ -60,7 +41,149 @@ std::string resolve_link(const std::string& text, const std::string& file) {
   return address ? "file:" + address->path : text;
 }
 
+/// A link address (rover_source, base_source), checked as it is read; `relative_file`: a file: address is relative
+/// to the configuration file's folder.
+struct LinkText {
+  using Yaml = std::string;
+  bool relative_file = false;
+  [[nodiscard]] std::string to(const std::string& text) const { return text; }
+  void from(const std::string& value, std::string& text, Reading& reading) const {
+    text = relative_file ? resolve_link(value, reading.file()) : value;
+    if (auto a = pipeline::LinkAddress::parse(text); !text.empty() && !a) reading.fail(a.error().message);
+  }
+};
+
+/// pipeline.cpu_affinity.STAGE: the CPUs of a stage thread, [CPU, ...]; printed only when there are some.
+struct CpuList {
+  using Yaml = std::vector<double>;
+  [[nodiscard]] Yaml to(const std::vector<int>& cpus) const { return {cpus.begin(), cpus.end()}; }
+  [[nodiscard]] bool omitted(const std::vector<int>& cpus) const { return cpus.empty(); }
+  void from(const Yaml& numbers, std::vector<int>& cpus, Reading& reading) const {
+    cpus.clear();
+    for (const double n : numbers) {
+      if (n != std::floor(n) || n < 0.0 || n > pipeline::max_cpu_number()) {
+        reading.fail("CPU numbers are integers in 0.." + std::to_string(pipeline::max_cpu_number()));
+        break;
+      }
+      cpus.push_back(static_cast<int>(n));
+    }
+    std::sort(cpus.begin(), cpus.end());
+    cpus.erase(std::unique(cpus.begin(), cpus.end()), cpus.end());
+  }
+};
+
+const Table<pipeline::PipelineOptions>& cpu_affinity_table() {
+  static const Table<pipeline::PipelineOptions> table = [] {
+    Table<pipeline::PipelineOptions> t;
+    for (std::size_t s = 0; s < pipeline::kNumStages; ++s) {
+      const std::string stage = pipeline::stage_name(static_cast<pipeline::Stage>(s));
+      t.emplace_back(
+          stage, "", "threaded: the CPUs the " + stage + " stage's thread may run on (absent: any)",
+          [s](auto& p) -> auto& { return p.cpu_affinity[s]; }, CpuList{});
+    }
+    return t;
+  }();
+  return table;
+}
+
+const Table<pipeline::PipelineOptions>& pipeline_table() {
+  using P = pipeline::PipelineOptions;
+  static const Table<P> table{
+      {"threaded", "", "true: six threads and queues; false: one thread (as canyon process --pipeline sequential)",
+       at(&P::threaded)},
+      {"queue_capacity", "", "epochs per queue; a full queue blocks its producer", at(&P::queue_capacity), Count{}},
+      {"cpu_affinity", "threaded: the CPUs each stage thread may run on", whole, cpu_affinity_table()},
+  };
+  return table;
+}
+
+Names<RoverBaseSource> base_source_names() {
+  Names<RoverBaseSource> names;
+  for (const auto& [source, name] : kBaseSources) names.names.emplace_back(source, name);
+  return names;
+}
+
+const Table<R>& input_table() {
+  using L = pipeline::LinkOptions;
+  static const Table<R> table{
+      {"pace", "", "rover file replay speed: 1 real time, 10 ten times faster, 0 as fast as possible", at(&R::pace)},
+      {"rover", "", "rinex: estimator.rover | ubx: a u-blox receiver's UBX from rover_source", at(&R::rover),
+       Names<RoverInputKind>{{{RoverInputKind::Rinex, "rinex"}, {RoverInputKind::Ubx, "ubx"}}}},
+      {"rover_source", "", "ubx: file:PATH, serial:///dev/X?baud=N, tcp://HOST:PORT or ntrip://...",
+       at(&R::rover_source), LinkText{true}},
+      {"base", "", "file: estimator.base | dds: RtcmFrame samples | ntrip, tcp: RTCM 3 from base_source", at(&R::base),
+       base_source_names()},
+      {"base_source", "", "ntrip: ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT; tcp: tcp://HOST:PORT", at(&R::base_source),
+       LinkText{false}},
+      {"stream_ephemerides", "", "add the ephemerides of the UBX and RTCM 3 streams to estimator.nav's",
+       at(&R::stream_ephemerides)},
+      {"link_attempts", "", "tcp, ntrip: give up after this many failed connection attempts in a row (0: never)",
+       at(&R::link, &L::attempts)},
+      {"link_stall_timeout_s", "s", "tcp, ntrip: no byte for this long counts as a dead connection",
+       at(&R::link, &L::stall_timeout_s)},
+      {"base_wait_s", "s", "dds, ntrip, tcp: how long a rover epoch waits for the base to reach its time",
+       at(&R::base_wait_s)},
+      {"ntrip_gga_interval_s", "s", "ntrip: upload the rover's latest position as NMEA GGA this often; 0: never",
+       at(&R::ntrip_gga_interval_s)},
+      {"base_queue_frames", "", "dds: RTCM frames queued between the DDS listener and ingest; beyond: dropped",
+       at(&R::base_queue_frames), Count{}},
+      {"vio", "", "fusion: file: estimator.vio and timesync | dds: VioPose and TimeSyncSample samples", at(&R::vio_dds),
+       Names<bool>{{{false, "file"}, {true, "dds"}}}},
+      {"vio_wait_s", "s", "dds VIO: longest an epoch waits for the VIO to cover its time", at(&R::vio_wait_s)},
+      {"vio_queue_poses", "", "dds VIO: poses queued between the DDS listener and the time bridge; beyond: dropped",
+       at(&R::vio_queue_poses), Count{}},
+  };
+  return table;
+}
+
+const Table<R>& dds_table() {
+  static const Table<R> table{
+      {"domain", "", "DDS domain id, 0-232", at(&R::domain)},
+      {"profiles", "", "Fast DDS XML profiles (\"\": the shipped config/dds/canyon_profiles.xml)", at(&R::profiles)},
+      {"rtcm_topic", "", "base corrections in (input.base dds)", at(&R::rtcm_topic)},
+      {"solution_topic", "", "canyon::msg::Solution out, one per epoch", at(&R::solution_topic)},
+      {"timing_topic", "", "canyon::msg::StageTiming out: stage times, queues, drops, correction age",
+       at(&R::timing_topic)},
+      {"vio_topic", "", "canyon::msg::VioPose in (input.vio dds)", at(&R::vio_topic)},
+      {"timesync_topic", "", "canyon::msg::TimeSyncSample in (input.vio dds)", at(&R::timesync_topic)},
+      {"publish_stages", "", "also the stages' outputs: canyon/bridged, alignment, prior and float",
+       at(&R::publish_stages)},
+  };
+  return table;
+}
+
+/// estimator: the keys of canyon process, read by parse_process_config() (its errors name the keys without the
+/// `estimator.` prefix, as before the tables).
+Entry<R> estimator_entry() {
+  Entry<R> e{"estimator", "the estimator and its inputs: the keys of canyon process (mode rtk or fusion)",
+             at(&R::estimator), process_table()};
+  e.read = [](R& c, YamlMap& map) {
+    auto estimator = parse_process_config(map.raw("estimator"), map.file());
+    if (estimator) {
+      c.estimator = std::move(*estimator);
+    } else {
+      map.add_error(estimator.error());
+    }
+  };
+  return e;
+}
+
 }  // namespace
+
+const Table<RoverConfig>& rover_table() {
+  static const Table<R> table{
+      estimator_entry(),
+      {"rover_id", "", "names this rover in its messages (1-64 characters)", at(&R::rover_id)},
+      {"input", "the rover's observations, the base's corrections and the VIO", whole, input_table()},
+      {"pipeline", "the six stages' threads and queues", at(&R::pipeline), pipeline_table()},
+      {"dds", "DDS domain, QoS profiles and topics", whole, dds_table()},
+  };
+  return table;
+}
+
+std::vector<KeyDescription> describe_rover_config() {
+  return describe_keys(rover_table(), RoverConfig{}, Numbers::Digits12);
+}
 
 const char* rover_base_source_name(RoverBaseSource source) {
   for (const auto& [s, name] : kBaseSources) {
@@ -114,7 +237,7 @@ std::string RoverConfig::validate() const {
 }
 
 bool operator==(const RoverConfig& a, const RoverConfig& b) {
-  return to_yaml(a) == to_yaml(b);
+  return equal_keys(rover_table(), a, b);
 }
 
 Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string& file) {
@@ -123,71 +246,7 @@ Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string
   if (!top.has("estimator")) {
     return Error{"'estimator:' (the canyon process keys: mode, rover, base, nav, ...) is required", file, 0};
   }
-  (void)top.sub("estimator");
-  auto estimator = parse_process_config(node["estimator"], file);
-  if (!estimator) return estimator.error();
-  c.estimator = std::move(*estimator);
-  top.get("rover_id", c.rover_id);
-  YamlMap input = top.sub("input");
-  input.get("pace", c.pace);
-  std::string rover = c.rover == RoverInputKind::Ubx ? "ubx" : "rinex";
-  input.get("rover", rover);
-  if (rover == "rinex" || rover == "ubx") {
-    c.rover = rover == "ubx" ? RoverInputKind::Ubx : RoverInputKind::Rinex;
-  } else {
-    input.fail("rover", "must be rinex or ubx, not '" + rover + "'");
-  }
-  input.get("rover_source", c.rover_source);
-  c.rover_source = resolve_link(c.rover_source, file);
-  if (auto a = pipeline::LinkAddress::parse(c.rover_source); !c.rover_source.empty() && !a)
-    input.fail("rover_source", a.error().message);
-  std::string base = rover_base_source_name(c.base);
-  input.get("base", base);
-  const auto* known =
-      std::find_if(kBaseSources.begin(), kBaseSources.end(), [&](const auto& s) { return base == s.second; });
-  if (known != kBaseSources.end()) {
-    c.base = known->first;
-  } else {
-    input.fail("base", "must be file, dds, ntrip or tcp, not '" + base + "'");
-  }
-  input.get("base_source", c.base_source);
-  if (auto a = pipeline::LinkAddress::parse(c.base_source); !c.base_source.empty() && !a)
-    input.fail("base_source", a.error().message);
-  input.get("stream_ephemerides", c.stream_ephemerides);
-  input.get("link_attempts", c.link.attempts);
-  input.get("link_stall_timeout_s", c.link.stall_timeout_s);
-  input.get("base_wait_s", c.base_wait_s);
-  input.get("ntrip_gga_interval_s", c.ntrip_gga_interval_s);
-  int frames = static_cast<int>(c.base_queue_frames);
-  input.get("base_queue_frames", frames);
-  c.base_queue_frames = frames < 0 ? 0 : static_cast<std::size_t>(frames);
-  std::string vio = c.vio_dds ? "dds" : "file";
-  input.get("vio", vio);
-  if (vio != "file" && vio != "dds") input.fail("vio", "must be file or dds, not '" + vio + "'");
-  c.vio_dds = vio == "dds";
-  input.get("vio_wait_s", c.vio_wait_s);
-  int poses = static_cast<int>(c.vio_queue_poses);
-  input.get("vio_queue_poses", poses);
-  c.vio_queue_poses = poses < 0 ? 0 : static_cast<std::size_t>(poses);
-  input.reject_unknown_keys();
-  YamlMap pipeline = top.sub("pipeline");
-  pipeline.get("threaded", c.pipeline.threaded);
-  int capacity = static_cast<int>(c.pipeline.queue_capacity);
-  pipeline.get("queue_capacity", capacity);
-  c.pipeline.queue_capacity = capacity < 0 ? 0 : static_cast<std::size_t>(capacity);
-  read_cpu_affinity(pipeline.sub("cpu_affinity"), c.pipeline);
-  pipeline.reject_unknown_keys();
-  YamlMap dds = top.sub("dds");
-  dds.get("domain", c.domain);
-  dds.get("profiles", c.profiles);
-  dds.get("rtcm_topic", c.rtcm_topic);
-  dds.get("solution_topic", c.solution_topic);
-  dds.get("timing_topic", c.timing_topic);
-  dds.get("vio_topic", c.vio_topic);
-  dds.get("timesync_topic", c.timesync_topic);
-  dds.get("publish_stages", c.publish_stages);
-  dds.reject_unknown_keys();
-  top.reject_unknown_keys();
+  read_keys(rover_table(), top, c);
   if (Status s = top.status(); !s) return s.error();
   return c;
 }
@@ -199,49 +258,7 @@ Result<RoverConfig> load_rover_config(const std::string& path) {
 }
 
 std::string to_yaml(const RoverConfig& c) {
-  YAML::Emitter out;
-  out << YAML::BeginMap;
-  out << YAML::Key << "estimator" << YAML::Value << YAML::Load(to_yaml(c.estimator));
-  out << YAML::Key << "rover_id" << YAML::Value << c.rover_id;
-  out << YAML::Key << "input" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "pace" << YAML::Value << c.pace;
-  out << YAML::Key << "rover" << YAML::Value << (c.rover == RoverInputKind::Ubx ? "ubx" : "rinex");
-  out << YAML::Key << "rover_source" << YAML::Value << c.rover_source;
-  out << YAML::Key << "base" << YAML::Value << rover_base_source_name(c.base);
-  out << YAML::Key << "base_source" << YAML::Value << c.base_source;
-  out << YAML::Key << "stream_ephemerides" << YAML::Value << c.stream_ephemerides;
-  out << YAML::Key << "link_attempts" << YAML::Value << c.link.attempts;
-  out << YAML::Key << "link_stall_timeout_s" << YAML::Value << c.link.stall_timeout_s;
-  out << YAML::Key << "base_wait_s" << YAML::Value << c.base_wait_s;
-  out << YAML::Key << "ntrip_gga_interval_s" << YAML::Value << c.ntrip_gga_interval_s;
-  out << YAML::Key << "base_queue_frames" << YAML::Value << c.base_queue_frames;
-  out << YAML::Key << "vio" << YAML::Value << (c.vio_dds ? "dds" : "file");
-  out << YAML::Key << "vio_wait_s" << YAML::Value << c.vio_wait_s;
-  out << YAML::Key << "vio_queue_poses" << YAML::Value << c.vio_queue_poses;
-  out << YAML::EndMap;
-  out << YAML::Key << "pipeline" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "threaded" << YAML::Value << c.pipeline.threaded;
-  out << YAML::Key << "queue_capacity" << YAML::Value << c.pipeline.queue_capacity;
-  out << YAML::Key << "cpu_affinity" << YAML::Value << YAML::BeginMap;
-  for (std::size_t s = 0; s < pipeline::kNumStages; ++s) {
-    const std::vector<int>& cpus = c.pipeline.cpu_affinity[s];
-    if (cpus.empty()) continue;
-    out << YAML::Key << pipeline::stage_name(static_cast<pipeline::Stage>(s)) << YAML::Value << YAML::Flow << cpus;
-  }
-  out << YAML::EndMap;
-  out << YAML::EndMap;
-  out << YAML::Key << "dds" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "domain" << YAML::Value << c.domain;
-  out << YAML::Key << "profiles" << YAML::Value << c.profiles;
-  out << YAML::Key << "rtcm_topic" << YAML::Value << c.rtcm_topic;
-  out << YAML::Key << "solution_topic" << YAML::Value << c.solution_topic;
-  out << YAML::Key << "timing_topic" << YAML::Value << c.timing_topic;
-  out << YAML::Key << "vio_topic" << YAML::Value << c.vio_topic;
-  out << YAML::Key << "timesync_topic" << YAML::Value << c.timesync_topic;
-  out << YAML::Key << "publish_stages" << YAML::Value << c.publish_stages;
-  out << YAML::EndMap;
-  out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  return yaml_text(rover_table(), c, Numbers::Digits12);
 }
 
 }  // namespace canyon::config

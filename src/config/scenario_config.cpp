@@ -1,4 +1,5 @@
-// Scenario files: strict YAML parsing, validation with line numbers, printing (see scenario_config.hpp).
+// Scenario files: their keys described once (config/scenarios/*.yaml show each with its unit and default), parsed,
+// validated with line numbers, printed and compared from that description (see scenario_config.hpp).
 
 #include "canyon/config/scenario_config.hpp"
 
@@ -7,10 +8,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <set>
-#include <sstream>
+#include <stdexcept>
 
 #include "canyon/config/shipped_config.hpp"
-#include "canyon/config/yaml_reader.hpp"
 #include "canyon/core/constants.hpp"
 
 namespace canyon::config {
@@ -19,230 +19,145 @@ namespace {
 namespace fs = std::filesystem;
 using sim::Scenario;
 
-std::string resolve(const std::string& path, const std::string& file) {
-  if (path.empty() || file.empty() || fs::path(path).is_absolute()) return path;
-  return (fs::path(file).parent_path() / path).lexically_normal().string();
-}
-
 // ---------------------------------------------------------------------------------------------------------------
-// Parsing helpers.
+// Codecs of the scenario's own forms.
 
-void parse_signals(YamlMap& map, const std::string& key, std::vector<core::SignalCode>& out) {
-  std::vector<std::string> texts;
-  texts.reserve(out.size());
-  for (const core::SignalCode s : out) texts.push_back(s.to_string());
-  map.get(key, texts);
-  std::vector<core::SignalCode> signals;
-  for (const std::string& t : texts) {
-    const auto s = core::parse_signal(t);
-    if (!s) {
-      map.fail(key, "has '" + t + "', not a RINEX band and attribute (e.g. 1C, 2L, 7Q)");
+struct QuotedText : Same<std::string> {
+  static constexpr bool kQuoted = true;
+};
+
+struct QuotedPath : Path {
+  static constexpr bool kQuoted = true;
+};
+
+/// seed: a whole number >= 0 (std::uint64_t, beyond what YAML integers hold).
+struct Seed {
+  using Yaml = std::string;
+  [[nodiscard]] std::string to(std::uint64_t seed) const { return std::to_string(seed); }
+  void from(const std::string& text, std::uint64_t& seed, Reading& reading) const {
+    try {
+      std::size_t used = 0;
+      seed = std::stoull(text, &used);
+      if (used != text.size() || text.front() == '-') throw std::invalid_argument("seed");
+    } catch (const std::exception&) {
+      reading.fail("must be a whole number >= 0, not '" + text + "'");
+    }
+  }
+};
+
+/// start: a GPST calendar time "YYYY-MM-DD hh:mm:ss", printed in quotes.
+struct StartTime {
+  using Yaml = std::string;
+  [[nodiscard]] std::string to(const core::GpsTime& start) const {
+    const core::CalendarTime c = core::gps_to_calendar(start);
+    char text[32];
+    std::snprintf(text, sizeof text, "%04d-%02d-%02d %02d:%02d:%02d", c.year, c.month, c.day, c.hour, c.minute,
+                  static_cast<int>(c.second));
+    return text;
+  }
+  void print(const core::GpsTime& start, Printer& printer) const {
+    const core::CalendarTime c = core::gps_to_calendar(start);
+    char text[40];
+    std::snprintf(text, sizeof text, "%04d-%02d-%02d %02d:%02d:%02d", c.year, c.month, c.day, c.hour, c.minute,
+                  static_cast<int>(std::lround(c.second)));
+    printer.value(std::string(text), true);
+  }
+  void from(const std::string& value, core::GpsTime& start, Reading& reading) const {
+    core::CalendarTime c;
+    char tail = 0;
+    if (std::sscanf(value.c_str(), "%d-%d-%d %d:%d:%lf%c", &c.year, &c.month, &c.day, &c.hour, &c.minute, &c.second,
+                    &tail) != 6 ||
+        !core::is_valid(c) || c.year < 1990 || c.year > 2100) {
+      reading.fail("must be a GPST calendar time \"YYYY-MM-DD hh:mm:ss\", not '" + value + "'");
       return;
     }
-    signals.push_back(*s);
+    start = core::calendar_to_gps(c);
   }
-  out = signals;
-}
+};
 
-void parse_vector3(YamlMap& map, const std::string& key, Eigen::Vector3d& out) {
-  std::vector<double> v = {out.x(), out.y(), out.z()};
-  map.get(key, v);
-  if (v.size() != 3) {
-    map.fail(key, "must be [x, y, z]");
-    return;
+/// origin.lat_deg, lon_deg: radians in the struct, degrees in YAML, within +-limit.
+struct DegreesWithin {
+  using Yaml = double;
+  double limit = 90.0;
+  std::string rule;
+  [[nodiscard]] double to(double rad) const { return rad * core::kRadToDeg; }
+  void from(double deg, double& rad, Reading& reading) const {
+    if (!(std::abs(deg) <= limit)) reading.fail(rule);
+    rad = deg * core::kDegToRad;
   }
-  out = Eigen::Vector3d(v[0], v[1], v[2]);
-}
+};
 
-void parse_start(YamlMap& map, core::GpsTime& start) {
-  const core::CalendarTime c0 = core::gps_to_calendar(start);
-  char text[32];
-  std::snprintf(text, sizeof text, "%04d-%02d-%02d %02d:%02d:%02d", c0.year, c0.month, c0.day, c0.hour, c0.minute,
-                static_cast<int>(c0.second));
-  std::string value = text;
-  map.get("start", value);
-  core::CalendarTime c;
-  char tail = 0;
-  if (std::sscanf(value.c_str(), "%d-%d-%d %d:%d:%lf%c", &c.year, &c.month, &c.day, &c.hour, &c.minute, &c.second,
-                  &tail) != 6 ||
-      !core::is_valid(c) || c.year < 1990 || c.year > 2100) {
-    map.fail("start", "must be a GPST calendar time \"YYYY-MM-DD hh:mm:ss\", not '" + value + "'");
-    return;
+/// RINEX band and attribute of each signal ([1C, 2L]).
+struct Signals {
+  using Yaml = std::vector<std::string>;
+  [[nodiscard]] Yaml to(const std::vector<core::SignalCode>& signals) const {
+    Yaml texts;
+    texts.reserve(signals.size());
+    for (const core::SignalCode s : signals) texts.push_back(s.to_string());
+    return texts;
   }
-  start = core::calendar_to_gps(c);
-}
-
-void parse_origin(YamlMap map, core::Geodetic& origin) {
-  double lat_deg = origin.lat_rad * core::kRadToDeg, lon_deg = origin.lon_rad * core::kRadToDeg;
-  map.get("lat_deg", lat_deg);
-  map.get("lon_deg", lon_deg);
-  map.get("height_m", origin.height_m);
-  if (!(std::abs(lat_deg) <= 80.0)) map.fail("lat_deg", "must be within [-80, 80]");
-  if (!(std::abs(lon_deg) <= 180.0)) map.fail("lon_deg", "must be within [-180, 180]");
-  origin.lat_rad = lat_deg * core::kDegToRad;
-  origin.lon_rad = lon_deg * core::kDegToRad;
-  map.reject_unknown_keys();
-}
-
-void parse_constellation(YamlMap map, sim::ConstellationOptions& o, const std::string& file) {
-  std::vector<std::string> systems = o.letters();
-  map.get("systems", systems);
-  std::string bad;
-  if (!o.set_from_letters(systems, &bad)) map.fail("systems", "has '" + bad + "'; allowed: G, R, E, C");
-  map.get("nav_file", o.nav_file);
-  o.nav_file = resolve(o.nav_file, file);
-  map.get("gps_satellites", o.gps_satellites);
-  map.get("glonass_satellites", o.glonass_satellites);
-  map.get("galileo_satellites", o.galileo_satellites);
-  map.get("beidou_satellites", o.beidou_satellites);
-  parse_signals(map, "gps_signals", o.gps_signals);
-  parse_signals(map, "glonass_signals", o.glonass_signals);
-  parse_signals(map, "galileo_signals", o.galileo_signals);
-  parse_signals(map, "beidou_signals", o.beidou_signals);
-  map.reject_unknown_keys();
-}
-
-void parse_city(YamlMap map, sim::CityOptions& o) {
-  map.get("buildings", o.buildings);
-  map.get("grid_azimuth_deg", o.grid_azimuth_deg);
-  map.get("street_width_m", o.street_width_m);
-  map.get("block_length_m", o.block_length_m);
-  map.get("block_width_m", o.block_width_m);
-  map.get("lot_width_min_m", o.lot_width_min_m);
-  map.get("lot_width_max_m", o.lot_width_max_m);
-  map.get("height_mean_m", o.height_mean_m);
-  map.get("height_sigma_m", o.height_sigma_m);
-  map.get("height_min_m", o.height_min_m);
-  map.get("height_max_m", o.height_max_m);
-  map.get("gap_probability", o.gap_probability);
-  map.get("margin_m", o.margin_m);
-  std::vector<double> blocks(o.blocks.begin(), o.blocks.end());
-  map.get("blocks", blocks);
-  o.blocks.clear();
-  for (const double b : blocks) {
-    if (b != std::floor(b) || std::abs(b) > 1e6) {
-      map.fail("blocks", "must be [nx, ny], whole numbers of blocks");
-      break;
+  void from(const Yaml& texts, std::vector<core::SignalCode>& out, Reading& reading) const {
+    std::vector<core::SignalCode> signals;
+    for (const std::string& t : texts) {
+      const auto s = core::parse_signal(t);
+      if (!s) {
+        reading.fail("has '" + t + "', not a RINEX band and attribute (e.g. 1C, 2L, 7Q)");
+        return;
+      }
+      signals.push_back(*s);
     }
-    o.blocks.push_back(static_cast<int>(b));
+    out = signals;
   }
-  map.reject_unknown_keys();
-}
+};
 
-void parse_trees(YamlMap map, sim::TreeOptions& o) {
-  map.get("spacing_m", o.spacing_m);
-  map.get("presence_probability", o.presence_probability);
-  map.get("crown_radius_m", o.crown_radius_m);
-  map.get("crown_bottom_m", o.crown_bottom_m);
-  map.get("crown_top_m", o.crown_top_m);
-  map.get("attenuation_db_per_m", o.attenuation_db_per_m);
-  map.get("facade_offset_m", o.facade_offset_m);
-  map.reject_unknown_keys();
-}
-
-void parse_route(YamlMap map, sim::RouteOptions& o) {
-  map.get("speed_mps", o.speed_mps);
-  map.get("antenna_height_m", o.antenna_height_m);
-  map.get("sidewalk_offset_m", o.sidewalk_offset_m);
-  map.get("turn_probability", o.turn_probability);
-  map.get("turn_radius_m", o.turn_radius_m);
-  map.get("head_bob_m", o.head_bob_m);
-  map.get("step_frequency_hz", o.step_frequency_hz);
-  std::vector<std::vector<double>> points;
-  for (const Eigen::Vector2d& w : o.waypoints_N_m) points.push_back({w.x(), w.y()});
-  map.get("waypoints_m", points);
-  o.waypoints_N_m.clear();
-  for (const auto& p : points) {
-    if (p.size() != 2) {
-      map.fail("waypoints_m", "must be a list of [east, north] pairs (m)");
-      break;
+/// city.blocks: [nx, ny], whole numbers.
+struct Blocks {
+  using Yaml = std::vector<double>;
+  [[nodiscard]] Yaml to(const std::vector<int>& blocks) const { return {blocks.begin(), blocks.end()}; }
+  void from(const Yaml& numbers, std::vector<int>& blocks, Reading& reading) const {
+    blocks.clear();
+    for (const double b : numbers) {
+      if (b != std::floor(b) || std::abs(b) > 1e6) {
+        reading.fail("must be [nx, ny], whole numbers of blocks");
+        break;
+      }
+      blocks.push_back(static_cast<int>(b));
     }
-    o.waypoints_N_m.emplace_back(p[0], p[1]);
   }
-  map.reject_unknown_keys();
-}
+};
 
-void parse_base(YamlMap map, sim::BaseOptions& o) {
-  map.get("distance_m", o.distance_m);
-  map.get("azimuth_deg", o.azimuth_deg);
-  map.get("height_m", o.height_m);
-  map.get("rate_hz", o.rate_hz);
-  map.reject_unknown_keys();
-}
-
-void parse_receiver(YamlMap map, sim::ReceiverOptions& o) {
-  map.get("cn0_zenith_dbhz", o.cn0_zenith_dbhz);
-  map.get("cn0_horizon_dbhz", o.cn0_horizon_dbhz);
-  map.get("band2_cn0_offset_db", o.band2_cn0_offset_db);
-  map.get("cn0_noise_db", o.cn0_noise_db);
-  map.get("cn0_reference_dbhz", o.cn0_reference_dbhz);
-  map.get("code_sigma_m", o.code_sigma_m);
-  map.get("phase_sigma_m", o.phase_sigma_m);
-  map.get("doppler_sigma_hz", o.doppler_sigma_hz);
-  map.get("track_threshold_dbhz", o.track_threshold_dbhz);
-  map.get("acquire_threshold_dbhz", o.acquire_threshold_dbhz);
-  map.get("reacquisition_s", o.reacquisition_s);
-  map.get("slip_rate_hz", o.slip_rate_hz);
-  map.get("path_change_slip_probability", o.path_change_slip_probability);
-  map.get("correlator_spacing_chips", o.correlator_spacing_chips);
-  map.get("clock_offset_max_s", o.clock_offset_max_s);
-  map.get("clock_drift_max_sps", o.clock_drift_max_sps);
-  map.get("clock_drift_noise", o.clock_drift_noise);
-  map.get("elevation_cutoff_deg", o.elevation_cutoff_deg);
-  map.reject_unknown_keys();
-}
-
-void parse_reflections(YamlMap map, sim::ReflectionOptions& o) {
-  map.get("multipath", o.multipath);
-  map.get("nlos", o.nlos);
-  map.get("wall_loss_db", o.wall_loss_db);
-  map.get("nlos_extra_loss_db", o.nlos_extra_loss_db);
-  map.get("ground_loss_db", o.ground_loss_db);
-  map.get("max_wall_distance_m", o.max_wall_distance_m);
-  map.reject_unknown_keys();
-}
-
-void parse_atmosphere(YamlMap map, sim::AtmosphereOptions& o) {
-  map.get("vtec_tecu", o.vtec_tecu);
-  std::vector<double> g = {o.gradient_tecu_per_100km.x(), o.gradient_tecu_per_100km.y()};
-  map.get("gradient_tecu_per_100km", g);
-  if (g.size() == 2) {
-    o.gradient_tecu_per_100km = Eigen::Vector2d(g[0], g[1]);
-  } else {
-    map.fail("gradient_tecu_per_100km", "must be [east, north] (TECU per 100 km)");
+/// route.waypoints_m: [[east, north], ...].
+struct Waypoints {
+  using Yaml = std::vector<std::vector<double>>;
+  [[nodiscard]] Yaml to(const std::vector<Eigen::Vector2d>& points) const {
+    Yaml rows;
+    for (const Eigen::Vector2d& w : points) rows.push_back({w.x(), w.y()});
+    return rows;
   }
-  map.get("wave_amplitude_tecu", o.wave_amplitude_tecu);
-  map.get("wave_count", o.wave_count);
-  map.get("wave_length_km", o.wave_length_km);
-  map.get("wave_period_s", o.wave_period_s);
-  map.get("shell_height_km", o.shell_height_km);
-  map.get("zwd_residual_m", o.zwd_residual_m);
-  map.get("zwd_difference_m", o.zwd_difference_m);
-  map.get("zwd_variation_m", o.zwd_variation_m);
-  map.reject_unknown_keys();
-}
+  void from(const Yaml& rows, std::vector<Eigen::Vector2d>& points, Reading& reading) const {
+    points.clear();
+    for (const auto& p : rows) {
+      if (p.size() != 2) {
+        reading.fail("must be a list of [east, north] pairs (m)");
+        break;
+      }
+      points.emplace_back(p[0], p[1]);
+    }
+  }
+};
 
-void parse_orbit_errors(YamlMap map, sim::OrbitErrorOptions& o) {
-  map.get("radial_m", o.radial_m);
-  map.get("along_m", o.along_m);
-  map.get("cross_m", o.cross_m);
-  map.get("clock_m", o.clock_m);
-  map.reject_unknown_keys();
-}
-
-void parse_vio(YamlMap map, sim::VioOptions& o) {
-  map.get("enabled", o.enabled);
-  parse_vector3(map, "t_IA_m", o.t_IA_m);
-  map.get("odometry_yaw_deg", o.odometry_yaw_deg);
-  map.get("rate_hz", o.rate_hz);
-  map.get("position_drift_fraction", o.position_drift_fraction);
-  map.get("yaw_drift_deg_per_km", o.yaw_drift_deg_per_km);
-  map.get("tilt_drift_deg_per_km", o.tilt_drift_deg_per_km);
-  map.get("device_clock_offset_s", o.device_clock_offset_s);
-  map.get("device_clock_drift_ppm", o.device_clock_drift_ppm);
-  map.get("timesync_jitter_s", o.timesync_jitter_s);
-  map.reject_unknown_keys();
-}
+/// atmosphere.gradient_tecu_per_100km: [east, north].
+struct EastNorth {
+  using Yaml = std::vector<double>;
+  [[nodiscard]] Yaml to(const Eigen::Vector2d& v) const { return {v.x(), v.y()}; }
+  void from(const Yaml& value, Eigen::Vector2d& v, Reading& reading) const {
+    if (value.size() == 2) {
+      v = Eigen::Vector2d(value[0], value[1]);
+    } else {
+      reading.fail("must be [east, north] (TECU per 100 km)");
+    }
+  }
+};
 
 /// Line of the key at a dotted path ("city.street_width_m") in `root`: the deepest key present, 0 if none.
 int line_of_path(const YAML::Node& root, const std::string& path) {
@@ -269,233 +184,239 @@ int line_of_path(const YAML::Node& root, const std::string& path) {
   return line;
 }
 
-// ---------------------------------------------------------------------------------------------------------------
-// Printing.
-
-/// Shortest decimal text that reads back as the same double.
-std::string number(double v) {
-  char buffer[40];
-  for (int precision = 1; precision <= 17; ++precision) {
-    std::snprintf(buffer, sizeof buffer, "%.*g", precision, v);
-    if (std::strtod(buffer, nullptr) == v) break;
-  }
-  std::string s = buffer;
-  return s;
-}
-
-class Writer {
- public:
-  void section(const std::string& name) { out_ << name << ":\n"; }
-  void key(const std::string& name, const std::string& value, int indent = 2) {
-    out_ << std::string(static_cast<std::size_t>(indent), ' ') << name << ": " << value << "\n";
-  }
-  void key(const std::string& name, double value, int indent = 2) { key(name, number(value), indent); }
-  void key(const std::string& name, int value, int indent = 2) { key(name, std::to_string(value), indent); }
-  void flag(const std::string& name, bool value, int indent = 2) { key(name, value ? "true" : "false", indent); }
-  [[nodiscard]] std::string text() const { return out_.str(); }
-
- private:
-  std::ostringstream out_;
-};
-
-std::string list(const std::vector<std::string>& items) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) s += ", ";
-    s += items[i];
-  }
-  return s + "]";
-}
-
-std::string signal_list(const std::vector<core::SignalCode>& signals) {
-  std::vector<std::string> items;
-  items.reserve(signals.size());
-  for (const core::SignalCode s : signals) items.push_back(s.to_string());
-  return list(items);
-}
-
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
-void write_receiver(Writer& w, const std::string& name, const sim::ReceiverOptions& o) {
-  w.section(name);
-  w.key("cn0_zenith_dbhz", o.cn0_zenith_dbhz);
-  w.key("cn0_horizon_dbhz", o.cn0_horizon_dbhz);
-  w.key("band2_cn0_offset_db", o.band2_cn0_offset_db);
-  w.key("cn0_noise_db", o.cn0_noise_db);
-  w.key("cn0_reference_dbhz", o.cn0_reference_dbhz);
-  w.key("code_sigma_m", o.code_sigma_m);
-  w.key("phase_sigma_m", o.phase_sigma_m);
-  w.key("doppler_sigma_hz", o.doppler_sigma_hz);
-  w.key("track_threshold_dbhz", o.track_threshold_dbhz);
-  w.key("acquire_threshold_dbhz", o.acquire_threshold_dbhz);
-  w.key("reacquisition_s", o.reacquisition_s);
-  w.key("slip_rate_hz", o.slip_rate_hz);
-  w.key("path_change_slip_probability", o.path_change_slip_probability);
-  w.key("correlator_spacing_chips", o.correlator_spacing_chips);
-  w.key("clock_offset_max_s", o.clock_offset_max_s);
-  w.key("clock_drift_max_sps", o.clock_drift_max_sps);
-  w.key("clock_drift_noise", o.clock_drift_noise);
-  w.key("elevation_cutoff_deg", o.elevation_cutoff_deg);
-}
-
-void write_scenario_body(Writer& w, const Scenario& s) {
-  w.key("name", quoted(s.name), 0);
-  w.key("seed", std::to_string(s.seed), 0);
-  const core::CalendarTime c = core::gps_to_calendar(s.start);
-  char start[40];
-  std::snprintf(start, sizeof start, "\"%04d-%02d-%02d %02d:%02d:%02d\"", c.year, c.month, c.day, c.hour, c.minute,
-                static_cast<int>(std::lround(c.second)));
-  w.key("start", start, 0);
-  w.key("duration_s", s.duration_s, 0);
-  w.key("rover_rate_hz", s.rover_rate_hz, 0);
-  w.section("origin");
-  w.key("lat_deg", s.origin.lat_rad * core::kRadToDeg);
-  w.key("lon_deg", s.origin.lon_rad * core::kRadToDeg);
-  w.key("height_m", s.origin.height_m);
-  const sim::ConstellationOptions& k = s.constellation;
-  w.section("constellation");
-  w.key("systems", list(k.letters()));
-  w.key("nav_file", quoted(k.nav_file));
-  w.key("gps_satellites", k.gps_satellites);
-  w.key("glonass_satellites", k.glonass_satellites);
-  w.key("galileo_satellites", k.galileo_satellites);
-  w.key("beidou_satellites", k.beidou_satellites);
-  w.key("gps_signals", signal_list(k.gps_signals));
-  w.key("glonass_signals", signal_list(k.glonass_signals));
-  w.key("galileo_signals", signal_list(k.galileo_signals));
-  w.key("beidou_signals", signal_list(k.beidou_signals));
-  const sim::CityOptions& city = s.city;
-  w.section("city");
-  w.flag("buildings", city.buildings);
-  w.key("grid_azimuth_deg", city.grid_azimuth_deg);
-  w.key("street_width_m", city.street_width_m);
-  w.key("block_length_m", city.block_length_m);
-  w.key("block_width_m", city.block_width_m);
-  w.key("lot_width_min_m", city.lot_width_min_m);
-  w.key("lot_width_max_m", city.lot_width_max_m);
-  w.key("height_mean_m", city.height_mean_m);
-  w.key("height_sigma_m", city.height_sigma_m);
-  w.key("height_min_m", city.height_min_m);
-  w.key("height_max_m", city.height_max_m);
-  w.key("gap_probability", city.gap_probability);
-  w.key("margin_m", city.margin_m);
-  std::vector<std::string> blocks;
-  for (const int b : city.blocks) blocks.push_back(std::to_string(b));
-  w.key("blocks", list(blocks));
-  const sim::TreeOptions& t = s.trees;
-  w.section("trees");
-  w.key("spacing_m", t.spacing_m);
-  w.key("presence_probability", t.presence_probability);
-  w.key("crown_radius_m", t.crown_radius_m);
-  w.key("crown_bottom_m", t.crown_bottom_m);
-  w.key("crown_top_m", t.crown_top_m);
-  w.key("attenuation_db_per_m", t.attenuation_db_per_m);
-  w.key("facade_offset_m", t.facade_offset_m);
-  const sim::RouteOptions& r = s.route;
-  w.section("route");
-  w.key("speed_mps", r.speed_mps);
-  w.key("antenna_height_m", r.antenna_height_m);
-  w.key("sidewalk_offset_m", r.sidewalk_offset_m);
-  w.key("turn_probability", r.turn_probability);
-  w.key("turn_radius_m", r.turn_radius_m);
-  w.key("head_bob_m", r.head_bob_m);
-  w.key("step_frequency_hz", r.step_frequency_hz);
-  std::vector<std::string> points;
-  for (const Eigen::Vector2d& p : r.waypoints_N_m)
-    points.push_back(std::string("[") + number(p.x()) + ", " + number(p.y()) + "]");
-  w.key("waypoints_m", list(points));
-  w.section("base");
-  w.key("distance_m", s.base.distance_m);
-  w.key("azimuth_deg", s.base.azimuth_deg);
-  w.key("height_m", s.base.height_m);
-  w.key("rate_hz", s.base.rate_hz);
-  write_receiver(w, "rover_receiver", s.rover_receiver);
-  write_receiver(w, "base_receiver", s.base_receiver);
-  w.section("reflections");
-  w.flag("multipath", s.reflections.multipath);
-  w.flag("nlos", s.reflections.nlos);
-  w.key("wall_loss_db", s.reflections.wall_loss_db);
-  w.key("nlos_extra_loss_db", s.reflections.nlos_extra_loss_db);
-  w.key("ground_loss_db", s.reflections.ground_loss_db);
-  w.key("max_wall_distance_m", s.reflections.max_wall_distance_m);
-  const sim::AtmosphereOptions& a = s.atmosphere;
-  w.section("atmosphere");
-  w.key("vtec_tecu", a.vtec_tecu);
-  w.key("gradient_tecu_per_100km",
-        std::string("[") + number(a.gradient_tecu_per_100km.x()) + ", " + number(a.gradient_tecu_per_100km.y()) + "]");
-  w.key("wave_amplitude_tecu", a.wave_amplitude_tecu);
-  w.key("wave_count", a.wave_count);
-  w.key("wave_length_km", a.wave_length_km);
-  w.key("wave_period_s", a.wave_period_s);
-  w.key("shell_height_km", a.shell_height_km);
-  w.key("zwd_residual_m", a.zwd_residual_m);
-  w.key("zwd_difference_m", a.zwd_difference_m);
-  w.key("zwd_variation_m", a.zwd_variation_m);
-  w.section("orbit_errors");
-  w.key("radial_m", s.orbit_errors.radial_m);
-  w.key("along_m", s.orbit_errors.along_m);
-  w.key("cross_m", s.orbit_errors.cross_m);
-  w.key("clock_m", s.orbit_errors.clock_m);
-  w.section("vio");
-  w.flag("enabled", s.vio.enabled);
-  const Eigen::Vector3d& l = s.vio.t_IA_m;
-  w.key("t_IA_m", std::string("[") + number(l.x()) + ", " + number(l.y()) + ", " + number(l.z()) + "]");
-  w.key("odometry_yaw_deg", s.vio.odometry_yaw_deg);
-  w.key("rate_hz", s.vio.rate_hz);
-  w.key("position_drift_fraction", s.vio.position_drift_fraction);
-  w.key("yaw_drift_deg_per_km", s.vio.yaw_drift_deg_per_km);
-  w.key("tilt_drift_deg_per_km", s.vio.tilt_drift_deg_per_km);
-  w.key("device_clock_offset_s", s.vio.device_clock_offset_s);
-  w.key("device_clock_drift_ppm", s.vio.device_clock_drift_ppm);
-  w.key("timesync_jitter_s", s.vio.timesync_jitter_s);
-}
-
 std::vector<fs::path> scenario_folders() {
   std::vector<fs::path> folders;
   for (const std::string& config : shipped_config_folders()) folders.push_back(fs::path(config) / "scenarios");
   return folders;
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// The keys, section by section.
+
+const Table<core::Geodetic>& origin_table() {
+  using G = core::Geodetic;
+  static const Table<G> table{
+      {"lat_deg", "deg", "latitude", at(&G::lat_rad), DegreesWithin{80.0, "must be within [-80, 80]"}},
+      {"lon_deg", "deg", "longitude", at(&G::lon_rad), DegreesWithin{180.0, "must be within [-180, 180]"}},
+      {"height_m", "m", "ground ellipsoidal height", at(&G::height_m)},
+  };
+  return table;
+}
+
+const Table<sim::ConstellationOptions>& constellation_table() {
+  using C = sim::ConstellationOptions;
+  static const Table<C> table{
+      {"systems", "", "G GPS, R GLONASS, E Galileo, C BeiDou (MEO)", whole, Systems{"G, R, E, C"}},
+      {"nav_file", "", "RINEX navigation file to take the orbits from; empty: the built-in constellation",
+       at(&C::nav_file), QuotedPath{}},
+      {"gps_satellites", "", "built-in: 24 nominal slots + spares, 24..32", at(&C::gps_satellites)},
+      {"glonass_satellites", "", "built-in, 1..24", at(&C::glonass_satellites)},
+      {"galileo_satellites", "", "built-in, 1..24", at(&C::galileo_satellites)},
+      {"beidou_satellites", "", "built-in MEO, 1..24", at(&C::beidou_satellites)},
+      {"gps_signals", "", "RINEX band+attribute tracked, first the L1-band one", at(&C::gps_signals), Signals{}},
+      {"glonass_signals", "", "RINEX band+attribute tracked", at(&C::glonass_signals), Signals{}},
+      {"galileo_signals", "", "RINEX band+attribute tracked", at(&C::galileo_signals), Signals{}},
+      {"beidou_signals", "", "RINEX band+attribute tracked", at(&C::beidou_signals), Signals{}},
+  };
+  return table;
+}
+
+const Table<sim::CityOptions>& city_table() {
+  using C = sim::CityOptions;
+  static const Table<C> table{
+      {"buildings", "", "false: open area, the grid only guides the walk", at(&C::buildings)},
+      {"grid_azimuth_deg", "deg", "azimuth of the avenues, clockwise from north", at(&C::grid_azimuth_deg)},
+      {"street_width_m", "m", "facade to facade, > 0", at(&C::street_width_m)},
+      {"block_length_m", "m", "block size along the avenues, > 0", at(&C::block_length_m)},
+      {"block_width_m", "m", "block size across the avenues, > 0", at(&C::block_width_m)},
+      {"lot_width_min_m", "m", "narrowest building frontage", at(&C::lot_width_min_m)},
+      {"lot_width_max_m", "m", "widest building frontage", at(&C::lot_width_max_m)},
+      {"height_mean_m", "m", "mean building height before clipping", at(&C::height_mean_m)},
+      {"height_sigma_m", "m", "standard deviation of building heights, >= 0", at(&C::height_sigma_m)},
+      {"height_min_m", "m", "lowest building, >= 0", at(&C::height_min_m)},
+      {"height_max_m", "m", "tallest building, >= height_min_m", at(&C::height_max_m)},
+      {"gap_probability", "", "probability that a lot is empty (plaza, parking), 0..1", at(&C::gap_probability)},
+      {"margin_m", "m", "buildings at least this far around the route", at(&C::margin_m)},
+      {"blocks", "", "[nx, ny]: a city of nx by ny blocks centred on the origin; []: sized to the route",
+       at(&C::blocks), Blocks{}},
+  };
+  return table;
+}
+
+const Table<sim::TreeOptions>& trees_table() {
+  using T = sim::TreeOptions;
+  static const Table<T> table{
+      {"spacing_m", "m", "distance between trees along a street; 0: no trees", at(&T::spacing_m)},
+      {"presence_probability", "", "probability that a tree stands at each spot, 0..1", at(&T::presence_probability)},
+      {"crown_radius_m", "m", "crown radius", at(&T::crown_radius_m)},
+      {"crown_bottom_m", "m", "height of the lowest leaves", at(&T::crown_bottom_m)},
+      {"crown_top_m", "m", "tree height", at(&T::crown_top_m)},
+      {"attenuation_db_per_m", "dB/m", "signal loss per metre of crown crossed", at(&T::attenuation_db_per_m)},
+      {"facade_offset_m", "m", "tree line distance from the facades", at(&T::facade_offset_m)},
+  };
+  return table;
+}
+
+const Table<sim::RouteOptions>& route_table() {
+  using R = sim::RouteOptions;
+  static const Table<R> table{
+      {"speed_mps", "m/s", "walking speed", at(&R::speed_mps)},
+      {"antenna_height_m", "m", "antenna above the ground", at(&R::antenna_height_m)},
+      {"sidewalk_offset_m", "m", "walking line distance from the facades, < street_width_m / 2",
+       at(&R::sidewalk_offset_m)},
+      {"turn_probability", "", "probability of turning at an intersection, 0..1", at(&R::turn_probability)},
+      {"turn_radius_m", "m", "radius of the walk at corners", at(&R::turn_radius_m)},
+      {"head_bob_m", "m", "vertical head motion amplitude", at(&R::head_bob_m)},
+      {"step_frequency_hz", "Hz", "step frequency", at(&R::step_frequency_hz)},
+      {"waypoints_m", "m",
+       "explicit route [[east, north], ...] from the origin, walked back and forth; []: a random walk",
+       at(&R::waypoints_N_m), Waypoints{}},
+  };
+  return table;
+}
+
+const Table<sim::BaseOptions>& base_station_table() {
+  using B = sim::BaseOptions;
+  static const Table<B> table{
+      {"distance_m", "m", "from the city origin", at(&B::distance_m)},
+      {"azimuth_deg", "deg", "direction from the origin, clockwise from north", at(&B::azimuth_deg)},
+      {"height_m", "m", "antenna ellipsoidal height", at(&B::height_m)},
+      {"rate_hz", "Hz", "observation rate", at(&B::rate_hz)},
+  };
+  return table;
+}
+
+const Table<sim::ReceiverOptions>& receiver_table() {
+  using R = sim::ReceiverOptions;
+  static const Table<R> table{
+      {"cn0_zenith_dbhz", "dB-Hz", "line-of-sight C/N0 at 90 deg elevation, first band", at(&R::cn0_zenith_dbhz)},
+      {"cn0_horizon_dbhz", "dB-Hz", "... at 0 deg; in between (1 - sin el)^2", at(&R::cn0_horizon_dbhz)},
+      {"band2_cn0_offset_db", "dB", "second band relative to the first", at(&R::band2_cn0_offset_db)},
+      {"cn0_noise_db", "dB", "noise of the reported C/N0", at(&R::cn0_noise_db)},
+      {"cn0_reference_dbhz", "dB-Hz", "C/N0 at which the three sigmas below hold", at(&R::cn0_reference_dbhz)},
+      {"code_sigma_m", "m", "pseudorange noise at the reference C/N0, x 10^((ref - C/N0) / 20)", at(&R::code_sigma_m)},
+      {"phase_sigma_m", "m", "carrier-phase noise at the reference C/N0, same scaling", at(&R::phase_sigma_m)},
+      {"doppler_sigma_hz", "Hz", "Doppler noise at the reference C/N0, same scaling", at(&R::doppler_sigma_hz)},
+      {"track_threshold_dbhz", "dB-Hz", "weaker signals lose lock", at(&R::track_threshold_dbhz)},
+      {"acquire_threshold_dbhz", "dB-Hz", "a lost signal must be this strong to be reacquired",
+       at(&R::acquire_threshold_dbhz)},
+      {"reacquisition_s", "s", "time a lost signal must be receivable before it is output again",
+       at(&R::reacquisition_s)},
+      {"slip_rate_hz", "1/s", "cycle slips at the tracking threshold, 10x fewer per 10 dB above", at(&R::slip_rate_hz)},
+      {"path_change_slip_probability", "", "lock lost when the received path changes (direct <-> reflected)",
+       at(&R::path_change_slip_probability)},
+      {"correlator_spacing_chips", "chips", "early-late spacing of the code loop", at(&R::correlator_spacing_chips)},
+      {"clock_offset_max_s", "s", "initial clock offset drawn in +-this", at(&R::clock_offset_max_s)},
+      {"clock_drift_max_sps", "s/s", "initial clock drift drawn in +-this", at(&R::clock_drift_max_sps)},
+      {"clock_drift_noise", "s/s per sqrt(s)", "clock drift random walk", at(&R::clock_drift_noise)},
+      {"elevation_cutoff_deg", "deg", "no signal tracked below", at(&R::elevation_cutoff_deg)},
+  };
+  return table;
+}
+
+const Table<sim::ReflectionOptions>& reflections_table() {
+  using R = sim::ReflectionOptions;
+  static const Table<R> table{
+      {"multipath", "", "line-of-sight signals also get wall and ground reflections", at(&R::multipath)},
+      {"nlos", "", "a signal a building blocks is received by a wall reflection; false: not at all", at(&R::nlos)},
+      {"wall_loss_db", "dB", "wall reflection power below the direct signal", at(&R::wall_loss_db)},
+      {"nlos_extra_loss_db", "dB", "extra loss of a reflection received without the direct signal",
+       at(&R::nlos_extra_loss_db)},
+      {"ground_loss_db", "dB", "ground reflection power below the direct signal", at(&R::ground_loss_db)},
+      {"max_wall_distance_m", "m", "walls further from the antenna reflect nothing", at(&R::max_wall_distance_m)},
+  };
+  return table;
+}
+
+const Table<sim::AtmosphereOptions>& atmosphere_table() {
+  using A = sim::AtmosphereOptions;
+  static const Table<A> table{
+      {"vtec_tecu", "TECU", "mean vertical TEC (1 TECU = 0.162 m on L1)", at(&A::vtec_tecu)},
+      {"gradient_tecu_per_100km", "TECU per 100 km", "VTEC gradient [east, north]", at(&A::gradient_tecu_per_100km),
+       EastNorth{}},
+      {"wave_amplitude_tecu", "TECU", "travelling ionospheric disturbances: amplitude of each",
+       at(&A::wave_amplitude_tecu)},
+      {"wave_count", "", "number of disturbances", at(&A::wave_count)},
+      {"wave_length_km", "km", "their mean wavelength", at(&A::wave_length_km)},
+      {"wave_period_s", "s", "their mean period", at(&A::wave_period_s)},
+      {"shell_height_km", "km", "thin ionospheric shell", at(&A::shell_height_km)},
+      {"zwd_residual_m", "m", "rover zenith wet delay not in Saastamoinen's model", at(&A::zwd_residual_m)},
+      {"zwd_difference_m", "m", "base minus rover residual zenith wet delay", at(&A::zwd_difference_m)},
+      {"zwd_variation_m", "m", "slow variation of each residual", at(&A::zwd_variation_m)},
+  };
+  return table;
+}
+
+const Table<sim::OrbitErrorOptions>& orbit_errors_table() {
+  using O = sim::OrbitErrorOptions;
+  static const Table<O> table{
+      {"radial_m", "m", "radial orbit error, 1 sigma", at(&O::radial_m)},
+      {"along_m", "m", "along-track orbit error, 1 sigma", at(&O::along_m)},
+      {"cross_m", "m", "cross-track orbit error, 1 sigma", at(&O::cross_m)},
+      {"clock_m", "m", "c x satellite clock error, 1 sigma", at(&O::clock_m)},
+  };
+  return table;
+}
+
+const Table<sim::VioOptions>& vio_table() {
+  using V = sim::VioOptions;
+  static const Table<V> table{
+      {"enabled", "", "write vio.csv and timesync.csv", at(&V::enabled)},
+      {"t_IA_m", "m", "antenna position in the IMU frame (lever arm)", at(&V::t_IA_m), Vector3{}},
+      {"odometry_yaw_deg", "deg", "yaw of the odometry frame from east, counter-clockwise", at(&V::odometry_yaw_deg)},
+      {"rate_hz", "Hz", "VIO pose rate, device clock", at(&V::rate_hz)},
+      {"position_drift_fraction", "", "1-sigma 3-D translation random walk after 1 km, per distance",
+       at(&V::position_drift_fraction)},
+      {"yaw_drift_deg_per_km", "deg", "1-sigma heading random walk after 1 km walked", at(&V::yaw_drift_deg_per_km)},
+      {"tilt_drift_deg_per_km", "deg", "1-sigma roll/pitch random walk after 1 km walked",
+       at(&V::tilt_drift_deg_per_km)},
+      {"device_clock_offset_s", "s", "device clock reading at the start", at(&V::device_clock_offset_s)},
+      {"device_clock_drift_ppm", "ppm", "device clock rate error", at(&V::device_clock_drift_ppm)},
+      {"timesync_jitter_s", "s", "jitter of the built-in GPS time-sync pairs, 1 sigma", at(&V::timesync_jitter_s)},
+  };
+  return table;
+}
+
 }  // namespace
+
+const Table<sim::Scenario>& scenario_table() {
+  static const Table<Scenario> table{
+      {"name", "", "the scenario's name", at(&Scenario::name), QuotedText{}},
+      {"seed", "", "random seed (integer >= 0); --seed overrides", at(&Scenario::seed), Seed{}},
+      {"start", "", "first epoch, GPST calendar time \"YYYY-MM-DD hh:mm:ss\"", at(&Scenario::start), StartTime{}},
+      {"duration_s", "s", "scenario length, 1..86400", at(&Scenario::duration_s)},
+      {"rover_rate_hz", "Hz", "rover observation rate", at(&Scenario::rover_rate_hz)},
+      {"origin", "city origin (the local ENU frame's)", at(&Scenario::origin), origin_table()},
+      {"constellation", "satellites and signals", at(&Scenario::constellation), constellation_table()},
+      {"city", "2.5-D street grid city generated around the route", at(&Scenario::city), city_table()},
+      {"trees", "street trees: crowns as vertical cylinders along the sidewalks", at(&Scenario::trees), trees_table()},
+      {"route", "the pedestrian with a head-worn antenna", at(&Scenario::route), route_table()},
+      {"base", "static base station under open sky", at(&Scenario::base), base_station_table()},
+      {"rover_receiver", "the rover's receiver", at(&Scenario::rover_receiver), receiver_table()},
+      {"base_receiver", "the base's receiver (keys as rover_receiver)", at(&Scenario::base_receiver), receiver_table()},
+      {"reflections", "at the rover (the base has none)", at(&Scenario::reflections), reflections_table()},
+      {"atmosphere", "true delays; the base-rover differences grow with the baseline", at(&Scenario::atmosphere),
+       atmosphere_table()},
+      {"orbit_errors", "broadcast orbit and clock errors", at(&Scenario::orbit_errors), orbit_errors_table()},
+      {"vio", "the device's visual-inertial odometry and clock", at(&Scenario::vio), vio_table()},
+      ignored_section<Scenario>("truth"),
+  };
+  return table;
+}
+
+std::vector<KeyDescription> describe_scenario() {
+  return describe_keys(scenario_table(), Scenario{}, Numbers::Shortest);
+}
+
+bool same_scenario(const sim::Scenario& a, const sim::Scenario& b) {
+  return equal_keys(scenario_table(), a, b);
+}
 
 Result<Scenario> parse_scenario(const YAML::Node& node, const std::string& file) {
   Scenario s;
   s.source_file = file;
   YamlMap top(node, file);
-  top.get("name", s.name);
-  std::string seed = std::to_string(s.seed);
-  top.get("seed", seed);
-  try {
-    std::size_t used = 0;
-    s.seed = std::stoull(seed, &used);
-    if (used != seed.size() || seed.front() == '-') throw std::invalid_argument("seed");
-  } catch (const std::exception&) {
-    top.fail("seed", "must be a whole number >= 0, not '" + seed + "'");
-  }
-  parse_start(top, s.start);
-  top.get("duration_s", s.duration_s);
-  top.get("rover_rate_hz", s.rover_rate_hz);
-  parse_origin(top.sub("origin"), s.origin);
-  parse_constellation(top.sub("constellation"), s.constellation, file);
-  parse_city(top.sub("city"), s.city);
-  parse_trees(top.sub("trees"), s.trees);
-  parse_route(top.sub("route"), s.route);
-  parse_base(top.sub("base"), s.base);
-  parse_receiver(top.sub("rover_receiver"), s.rover_receiver);
-  parse_receiver(top.sub("base_receiver"), s.base_receiver);
-  parse_reflections(top.sub("reflections"), s.reflections);
-  parse_atmosphere(top.sub("atmosphere"), s.atmosphere);
-  parse_orbit_errors(top.sub("orbit_errors"), s.orbit_errors);
-  parse_vio(top.sub("vio"), s.vio);
-  (void)top.sub("truth");  // written by canyon simulate; ignored
-  top.reject_unknown_keys();
+  read_keys(scenario_table(), top, s);
   if (Status st = top.status(); !st) return st.error();
   if (const std::string e = s.validate(); !e.empty()) {
     std::string key = e.substr(0, e.find(' '));
@@ -512,9 +433,7 @@ Result<Scenario> load_scenario(const std::string& path) {
 }
 
 std::string scenario_to_yaml(const Scenario& scenario, const std::string& truth_yaml) {
-  Writer w;
-  write_scenario_body(w, scenario);
-  std::string text = w.text();
+  std::string text = yaml_text(scenario_table(), scenario, Numbers::Shortest);
   if (!truth_yaml.empty()) text += "truth:\n" + truth_yaml;
   return text;
 }

@@ -2,6 +2,8 @@
 
 #include "canyon/config/yaml_reader.hpp"
 
+#include <utility>
+
 namespace canyon::config {
 
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
@@ -131,6 +133,15 @@ YamlMap YamlMap::sub(const std::string& key) {
   errors_->insert(errors_->end(), child.errors_->begin(), child.errors_->end());
   child.errors_ = errors_;
   return child;
+}
+
+YAML::Node YamlMap::raw(const std::string& key) {
+  asked_.insert(key);
+  return has(key) ? node_[key] : YAML::Node();
+}
+
+void YamlMap::add_error(Error error) {
+  errors_->push_back(std::move(error));
 }
 
 void YamlMap::fail(const std::string& key, const std::string& message) {

@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include "canyon/config/options_table.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/core/time.hpp"
 
@@ -79,6 +80,7 @@ struct BaseConfig {
   [[nodiscard]] std::string validate() const;
 };
 
+/// Equal when every key of base_table() is.
 [[nodiscard]] bool operator==(const BaseConfig& a, const BaseConfig& b);
 
 /// Parses a YAML node; `file` names the source in errors and anchors relative paths.
@@ -89,5 +91,10 @@ Result<BaseConfig> load_base_config(const std::string& path, BaseConfig defaults
 
 [[nodiscard]] std::string input_kind_name(BaseInputKind kind);
 [[nodiscard]] std::string input_source_name(BaseInputSource source);
+
+/// The base's keys (options_table.hpp), described once: they parse, print and compare it.
+[[nodiscard]] const Table<BaseConfig>& base_table();
+/// Every key with its unit, default (of BaseConfig{}) and doc.
+[[nodiscard]] std::vector<KeyDescription> describe_base_config();
 
 }  // namespace canyon::config

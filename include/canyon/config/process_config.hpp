@@ -1,34 +1,12 @@
 #pragma once
 // Configuration of `canyon process`: inputs, mode, output format and the estimator options, from a strict YAML
-// file and/or the command line. Relative paths in a YAML file are relative to that file's folder.
+// file and/or the command line. Relative paths in a YAML file are relative to that file's folder. Every key is
+// described once, in the tables below (process_config.cpp, estimator_tables.cpp): they parse, print and compare the
+// configuration, and `canyon process --describe-config` lists every key with its unit, default and doc.
 //
-// YAML keys (all optional; the command line overrides them):
-//   mode: spp                      # processing mode: spp | rtk | fusion
-//   rover: ROVER.obs               # rover RINEX observations (2.x/3.x, may be .gz)
-//   base: BASE.obs                 # base RINEX observations (rtk, fusion)
-//   vio: vio.csv                   # VIO poses (fusion; DESIGN.md contract, io/vio_file.hpp)
-//   timesync: timesync.csv         # the device's GPS time-sync pairs (fusion, unless fusion.vio_clock: gps)
-//   base_position: [X, Y, Z]       # base antenna ECEF (m); default: the base file's APPROX POSITION XYZ
-//   nav: [NAV1, NAV2]              # RINEX navigation files (one or a list)
-//   out: SOL.pos                   # solution file (RTKLIB .pos format)
-//   nmea: SOL.nmea                 # also write NMEA GGA sentences (optional)
-//   exclude_most_observed: 0       # leave out the N satellites (of the used constellations) tracked in the most
-//                                  # rover epochs: the paper's satellite-exclusion experiment on real data
-//   output:
-//     coordinates: llh             # llh | ecef
-//     time_format: tow             # tow (GPST week, seconds) | calendar (yyyy/mm/dd hh:mm:ss.sss)
-//   spp:                           # the single point: spp mode's solution, the RTK engine's prior and fallback
-//     elevation_mask_deg: 15       # deg
-//     systems: [G, R, E, C, J]     # constellations to use
-//     ionosphere: klobuchar        # klobuchar | off
-//     troposphere: saastamoinen    # saastamoinen | off
-//     code_sigma_m: 0.3            # zenith pseudorange noise (m)
-//     raim_fde: true               # exclude one faulty satellite when the chi-square test fails
-//     max_gdop: 30                 # reject solutions with a larger GDOP
-//     qzss_own_clock: false        # false: QZSS shares the GPS receiver clock
-//     exclude: [G05]               # satellites never used (rtk: exclude likewise keeps them out of both)
-//   rtk:                           # see config/rtk.yaml for every key with its unit and default
-//   fusion:                        # see config/fusion.yaml for every key with its unit and the paper's defaults
+// The keys (all optional; the command line overrides them): mode, the inputs (rover, base, vio, timesync,
+// base_position, nav), the outputs (out, nmea, output: coordinates and time_format), exclude_most_observed, and the
+// sections spp:, rtk: and fusion:. config/spp.yaml, rtk.yaml and fusion.yaml show each key with its unit and default.
 
 #include <optional>
 #include <string>
@@ -36,6 +14,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "canyon/config/options_table.hpp"
 #include "canyon/core/result.hpp"
 #include "canyon/fusion/fusion_options.hpp"
 #include "canyon/gnss/spp.hpp"
@@ -71,6 +50,7 @@ struct ProcessConfig {
   [[nodiscard]] rtk::RtkOptions rtk_engine_options() const;
 };
 
+/// Equal when every key of the tables is (the member itself where it can be compared, else its YAML form).
 [[nodiscard]] bool operator==(const ProcessConfig& a, const ProcessConfig& b);
 
 /// Parses a YAML node; `file` names the source in errors and anchors relative paths.
@@ -81,5 +61,14 @@ Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig
 [[nodiscard]] std::string to_yaml(const ProcessConfig& config);
 
 [[nodiscard]] std::string mode_name(ProcessMode mode);
+
+/// The keys of each section (options_table.hpp): spp:, rtk:, fusion: (flat keys over the per-piece structs), and the
+/// whole configuration with those as sections.
+[[nodiscard]] const Table<gnss::SppOptions>& spp_table();
+[[nodiscard]] const Table<rtk::RtkOptions>& rtk_table();
+[[nodiscard]] const Table<fusion::FusionOptions>& fusion_table();
+[[nodiscard]] const Table<ProcessConfig>& process_table();
+/// Every key with its unit, default (of ProcessConfig{}) and doc.
+[[nodiscard]] std::vector<KeyDescription> describe_process_config();
 
 }  // namespace canyon::config

@@ -1,6 +1,7 @@
 #pragma once
 // `canyon rover` configuration (config/rover.yaml documents every key): strict YAML parsing, printing, comparison
-// and validation. No DDS here: the rover executable (src/apps/canyon_rover_main.cpp) reads it.
+// and validation, all from the keys described once in rover_table(). No DDS here: the rover executable
+// (src/apps/canyon_rover_main.cpp) reads it.
 
 #include <string>
 
@@ -51,9 +52,15 @@ struct RoverConfig {
   [[nodiscard]] bool streamed_base() const { return base != RoverBaseSource::File; }
 };
 
+/// Equal when every key of rover_table() is.
 [[nodiscard]] bool operator==(const RoverConfig& a, const RoverConfig& b);
 Result<RoverConfig> parse_rover_config(const YAML::Node& node, const std::string& file);
 Result<RoverConfig> load_rover_config(const std::string& path);
 [[nodiscard]] std::string to_yaml(const RoverConfig& config);
+
+/// The rover's keys (options_table.hpp); `estimator:` holds process_table()'s.
+[[nodiscard]] const Table<RoverConfig>& rover_table();
+/// Every key with its unit, default (of RoverConfig{}) and doc.
+[[nodiscard]] std::vector<KeyDescription> describe_rover_config();
 
 }  // namespace canyon::config

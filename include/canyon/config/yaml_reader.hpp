@@ -31,7 +31,11 @@ class YamlMap {
   void get(const std::string& key, std::vector<std::vector<double>>& out);
   /// The sub-map at `key` (empty if absent).
   [[nodiscard]] YamlMap sub(const std::string& key);
+  /// The node at `key` as it is (undefined if absent), for a reader of its own; `key` counts as known.
+  [[nodiscard]] YAML::Node raw(const std::string& key);
   [[nodiscard]] bool has(const std::string& key) const;
+  /// The file this map was read from (errors name it; relative paths are relative to its folder).
+  [[nodiscard]] const std::string& file() const { return file_; }
 
   /// Records an error for every key of this map that was never asked for (call once all keys were read).
   void reject_unknown_keys();
@@ -39,6 +43,8 @@ class YamlMap {
   [[nodiscard]] Status status() const;
   /// Records an error about the value of `key` (e.g. an enumeration value that is not allowed).
   void fail(const std::string& key, const std::string& message);
+  /// Records an error found by a reader of its own (raw()).
+  void add_error(Error error);
 
  private:
   [[nodiscard]] std::string key_path(const std::string& key) const;
