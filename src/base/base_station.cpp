@@ -27,15 +27,6 @@ constexpr std::size_t kReadChunk = 4096;
 constexpr int kSliceMs = 100;
 constexpr double kFlushTimeoutS = 5.0;
 
-core::GpsTime now_gps() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  const core::CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
-                             utc.tm_hour,        utc.tm_min,     static_cast<double>(utc.tm_sec)};
-  return core::utc_to_gps(c, core::builtin_leap_seconds());
-}
-
 std::string format_epoch(const core::GpsTime& t) {
   const core::CalendarTime c = core::gps_to_calendar(t);
   char text[48];
@@ -313,7 +304,7 @@ Status BaseStation::run_bytes() {
   const config::BaseConfig& c = config_;
   io::GnssStreamOptions o;
   o.format = c.input.kind == config::BaseInputKind::Ubx ? io::StreamFormat::Ubx : io::StreamFormat::Rtcm3;
-  o.rtcm3.reference_time = c.input.approx_time.value_or(now_gps());
+  o.rtcm3.reference_time = c.input.approx_time.value_or(core::system_clock_gps(core::builtin_leap_seconds()));
   io::GnssStreamDecoder decoder(o);
   std::size_t kepler_seen = 0;
   std::size_t glonass_seen = 0;

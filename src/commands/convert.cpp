@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -30,15 +29,6 @@ std::string sibling(const std::string& input, const std::string& extension) {
   if (p.extension() == ".gz") p.replace_extension();
   p.replace_extension(extension);
   return p.string();
-}
-
-core::GpsTime now_gps() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  const core::CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
-                             utc.tm_hour,        utc.tm_min,     static_cast<double>(utc.tm_sec)};
-  return core::utc_to_gps(c, core::builtin_leap_seconds());
 }
 
 Result<std::vector<std::uint8_t>> record_stream(const ConvertConfig& config, const net::StreamUrl& url,
@@ -173,7 +163,7 @@ Result<ConvertSummary> binary_to_rinex(const ConvertConfig& config, const std::v
   ConvertSummary summary;
   io::GnssStreamOptions o;
   o.format = format;
-  const core::GpsTime now = now_gps();
+  const core::GpsTime now = core::system_clock_gps(core::builtin_leap_seconds());
   if (config.approx_time) {
     o.rtcm3.reference_time = *config.approx_time;
   } else if (format != io::StreamFormat::Ubx) {

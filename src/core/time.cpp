@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 
 namespace canyon::core {
 namespace {
@@ -239,6 +240,22 @@ std::string format_calendar(const CalendarTime& c, int decimals) {
   std::snprintf(buffer, sizeof buffer, "%04d-%02d-%02d %02d:%02d:%0*.*f", r.year, r.month, r.day, r.hour, r.minute,
                 decimals > 0 ? decimals + 3 : 2, decimals, r.second);
   return buffer;
+}
+
+std::string format_gpst(const GpsTime& t, int decimals) {
+  const GpsTime n = t.normalized();
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "GPST %d %.*f", n.week, decimals, n.tow_s);
+  return buffer;
+}
+
+GpsTime system_clock_gps(const LeapSecondTable& leaps) {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  const CalendarTime c{utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                       utc.tm_hour,        utc.tm_min,     static_cast<double>(utc.tm_sec)};
+  return utc_to_gps(c, leaps);
 }
 
 std::optional<GpsTime> parse_gps_calendar(const std::string& text) {

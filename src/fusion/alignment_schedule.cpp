@@ -5,20 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 namespace canyon::fusion {
 namespace {
 
 double sigma_3d(const Eigen::Matrix3d& P) {
   return std::sqrt(std::max(P.trace(), 0.0));
-}
-
-std::string when(const core::GpsTime& t) {
-  const core::GpsTime n = t.normalized();
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "GPST %d %.1f", n.week, n.tow_s);
-  return buffer;
 }
 
 }  // namespace
@@ -49,7 +41,7 @@ std::optional<std::string> AlignmentSchedule::align_new_segment_or_reuse(const c
   flush();
   std::optional<std::string> note;
   if (pose && last_segment_ && *last_segment_ != pose->segment) {
-    note = when(t) + ": new VIO segment " + std::to_string(pose->segment) +
+    note = core::format_gpst(t) + ": new VIO segment " + std::to_string(pose->segment) +
            " (gap or reset): RTK motion model until it aligns";
   }
   if (pose) last_segment_ = pose->segment;

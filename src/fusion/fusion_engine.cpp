@@ -15,13 +15,6 @@
 namespace canyon::fusion {
 namespace {
 
-std::string when(const core::GpsTime& t) {
-  const core::GpsTime n = t.normalized();
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "GPST %d %.1f", n.week, n.tow_s);
-  return buffer;
-}
-
 /// The RTK filter's options with the heading error state when the fusion estimates it.
 rtk::RtkOptions with_heading_state(rtk::RtkOptions rtk_options, const FusionOptions& options) {
   rtk_options.aiding_heading_state = options.heading.enabled && options.prediction.kind == Prediction::Vio;
@@ -301,7 +294,7 @@ void FusionEngine::check_integrity(const Eigen::Vector3d& p_out_E_m) {
                 ": integrity: the single points are %.0f m from the output (median over %.0f s): position moved to "
                 "them, ambiguities and heading restarted",
                 restart->offset_m, options_.integrity.window_s);
-  stats_.notes.push_back(when(epoch_time_) + text);
+  stats_.notes.push_back(core::format_gpst(epoch_time_) + text);
   ++stats_.integrity_restarts;
   engine_.set_position(restart->p_E_m, restart->P_E_m2);
   // The ambiguities were fitted to the old position; the heading may have been learnt from it.

@@ -8,13 +8,6 @@
 namespace canyon::fusion {
 namespace {
 
-std::string when(const core::GpsTime& t) {
-  const core::GpsTime n = t.normalized();
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "GPST %d %.1f", n.week, n.tow_s);
-  return buffer;
-}
-
 std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
   char buffer[256];
   std::snprintf(buffer, sizeof buffer, fmt, a, b, c, d);
@@ -66,7 +59,7 @@ std::vector<std::string> FusionEngine::report() const {
   const AlignmentEvent* last_coarse = nullptr;
   int coarse_run = 0;
   const auto coarse_line = [&lines](const AlignmentEvent& a, const char* what) {
-    lines.push_back("fusion: " + when(a.time) + ": " + what + ", " + std::to_string(a.points) +
+    lines.push_back("fusion: " + core::format_gpst(a.time) + ": " + what + ", " + std::to_string(a.points) +
                     format(" solutions, yaw sigma %.2f deg, horizontal RMSE %.2f m", a.yaw_sigma_deg, a.rmse_m));
   };
   const auto flush_coarse = [&]() {
@@ -82,7 +75,7 @@ std::vector<std::string> FusionEngine::report() const {
     }
     flush_coarse();
     if (a.kind == "realign") continue;
-    lines.push_back("fusion: " + when(a.time) + ": " + a.kind + " alignment, " + std::to_string(a.points) +
+    lines.push_back("fusion: " + core::format_gpst(a.time) + ": " + a.kind + " alignment, " + std::to_string(a.points) +
                     format(" solutions, FER %.3f, RMSE %.3f m (without calibration %.3f m)", a.first_eigenvalue_ratio,
                            a.rmse_m, a.rmse_without_calibration_m));
   }

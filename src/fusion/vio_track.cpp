@@ -14,13 +14,6 @@ namespace {
 
 constexpr double kMinResetTraceM2 = 1e-4;  // covariance collapses are only resets from above this trace (m^2)
 
-std::string when(const core::GpsTime& t) {
-  const core::GpsTime n = t.normalized();
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "GPST %d %.3f", n.week, n.tow_s);
-  return buffer;
-}
-
 }  // namespace
 
 std::string VioTrackOptions::validate() const {
@@ -73,8 +66,8 @@ void place_in_segment(const VioTrackSample* prev, VioTrackSample& s, const VioTr
   s.segment = prev->segment + 1;
   s.C_previous.setZero();  // no predecessor in its segment
   if (note != nullptr) {
-    *note = why + " at " + when(reference + s.t_s) + " (line " + std::to_string(s.line) + "): new VIO segment " +
-            std::to_string(s.segment) + ", fusion re-aligns";
+    *note = why + " at " + core::format_gpst(reference + s.t_s, 3) + " (line " + std::to_string(s.line) +
+            "): new VIO segment " + std::to_string(s.segment) + ", fusion re-aligns";
   }
 }
 

@@ -42,8 +42,11 @@ KalmanStep no_step(Eigen::Index n) {
   return KalmanStep{Eigen::VectorXd::Zero(n), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(n, 0)};
 }
 
+// v is taken by value and solved in place: Eigen's solveInPlace() takes its argument as a const reference and writes
+// through it, which clang-tidy reads as a copy used only as a const reference.
 std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P, const std::vector<const DdRow*>& rows,
-                                            Eigen::VectorXd v, const Eigen::MatrixXd& R) {
+                                            Eigen::VectorXd v,  // NOLINT(performance-unnecessary-value-param)
+                                            const Eigen::MatrixXd& R) {
   const CompressedJacobian c = compress(rows);
   const auto m = static_cast<Eigen::Index>(rows.size());
   const auto q = static_cast<Eigen::Index>(c.states.size());
@@ -68,7 +71,8 @@ std::optional<KalmanStep> compressed_update(const Eigen::MatrixXd& P, const std:
 }
 
 std::optional<KalmanStep> dense_update(const Eigen::MatrixXd& P, const KalmanStep& prior,
-                                       const std::vector<const DdRow*>& rows, Eigen::VectorXd v,
+                                       const std::vector<const DdRow*>& rows,
+                                       Eigen::VectorXd v,  // NOLINT(performance-unnecessary-value-param): as above
                                        const Eigen::MatrixXd& R) {
   const auto m = static_cast<Eigen::Index>(rows.size());
   KalmanStep step;

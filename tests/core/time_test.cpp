@@ -1,5 +1,6 @@
 #include "canyon/core/time.hpp"
 
+#include <ctime>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -161,6 +162,25 @@ TEST(PipelineClockTest, IsMonotonic) {
   const PipelineNs a = pipeline_now_ns();
   const PipelineNs b = pipeline_now_ns();
   EXPECT_LE(a, b);
+}
+
+TEST(FormatGpst, WeekAndTimeOfWeekNormalised) {
+  EXPECT_EQ(format_gpst(GpsTime{2175, 369000.04}), "GPST 2175 369000.0");
+  EXPECT_EQ(format_gpst(GpsTime{2175, 604800.5}, 3), "GPST 2176 0.500");
+  EXPECT_EQ(format_gpst(GpsTime{2176, -1.25}, 2), "GPST 2175 604798.75");
+}
+
+TEST(SystemClockGps, IsTheClockOnTheGpstScale) {
+  const LeapSecondTable leaps = builtin_leap_seconds();
+  const auto seconds_since_1970 = [](const GpsTime& t) {
+    // GPST 0 is 1980-01-06 00:00:00 UTC, 315964800 s after 1970; GPST - UTC is 18 s since 2017.
+    return static_cast<double>(t.week) * 604800.0 + t.tow_s + 315964800.0 - 18.0;
+  };
+  const double before = static_cast<double>(std::time(nullptr));
+  const double now = seconds_since_1970(system_clock_gps(leaps));
+  const double after = static_cast<double>(std::time(nullptr));
+  EXPECT_GE(now, before);
+  EXPECT_LE(now, after);
 }
 
 }  // namespace

@@ -195,7 +195,9 @@ TEST(FusionPieces, TheIntegrityCheckRestartsWhenTheMedianSinglePointIsFarOff) {
   for (int k = 0; k < 10 && !restart; ++k) {
     const Eigen::Vector3d spp = kP0 + R_EN * Eigen::Vector3d(30.0 + (k % 3), -5.0, 2.0);
     restart = check.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, spp);
-    if (k < 9) EXPECT_FALSE(restart.has_value()) << k;  // fewer than min_points
+    if (k < 9) {
+      EXPECT_FALSE(restart.has_value()) << k;  // fewer than min_points
+    }
   }
   ASSERT_TRUE(restart.has_value());
   const Eigen::Vector3d moved_N = R_EN.transpose() * (restart->p_E_m - kP0);

@@ -11,13 +11,20 @@ namespace canyon::pipeline::testing {
 /// An epoch bridged with a geometry that holds nothing.
 inline BridgedEpoch bridged_without_geometry(IngestedEpoch epoch) {
   static const gnss::EphemerisStore kNoEphemerides{core::NavigationData{}};
-  rtk::EpochGeometry geometry{gnss::EpochSatelliteStates(kNoEphemerides, epoch.rover.time), Error{"no geometry"}};
+  rtk::EpochGeometry geometry{gnss::EpochSatelliteStates(kNoEphemerides, epoch.rover.time),
+                              Error{"no geometry"},
+                              {},
+                              false,
+                              {},
+                              {},
+                              std::nullopt};
   return BridgedEpoch{std::move(epoch), fusion::FusionGeometry{std::move(geometry), std::nullopt, 0}, std::nullopt};
 }
 
 /// An epoch through every stage with the given output.
 inline SolvedEpoch solved_epoch(IngestedEpoch epoch, Result<EpochOutput> output) {
-  SolvedEpoch solved{UpdatedEpoch{PredictedEpoch{AlignedEpoch{bridged_without_geometry(std::move(epoch))}, true}, true}};
+  SolvedEpoch solved{
+      UpdatedEpoch{PredictedEpoch{AlignedEpoch{bridged_without_geometry(std::move(epoch))}, true}, true}};
   solved.output = std::move(output);
   return solved;
 }

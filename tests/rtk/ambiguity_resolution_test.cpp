@@ -128,7 +128,9 @@ TEST(AmbiguityResolution, AFixThatContradictsTheLastOneIsNotProposedAndHoldCondi
   shifted.state.restore_values(x, shifted.state.P());
   FixSearch search = resolver.search(shifted.state, shifted.sds);
   while (const FixCandidate* c = search.next()) {
-    if (!c->combinations) EXPECT_LE(c->a_fix.size(), 6) << "only sets without satellite 3 agree with the last fix";
+    if (!c->combinations) {
+      EXPECT_LE(c->a_fix.size(), 6) << "only sets without satellite 3 agree with the last fix";
+    }
     search.decide(false);
   }
   resolver.forget({shifted.sds[2].sat, 0});

@@ -4,6 +4,7 @@
 
 #include "canyon/rtk/filter_state.hpp"
 
+#include <cstdint>
 #include <random>
 
 #include <Eigen/Geometry>
@@ -16,7 +17,7 @@ namespace {
 constexpr double kTolerance = 1e-12;
 
 core::SatelliteId gps(int prn) {
-  return core::SatelliteId{core::Constellation::Gps, prn};
+  return core::SatelliteId{core::Constellation::Gps, static_cast<std::uint8_t>(prn)};
 }
 
 /// A random symmetric positive definite matrix.

@@ -61,7 +61,9 @@ TEST(SingleDifference, AnEpochDifferencedAtTheTruth) {
   ASSERT_GT(sds.size(), 10U);
   for (std::size_t i = 0; i < sds.size(); ++i) {
     const SingleDiff& sd = sds[i];
-    if (i > 0) EXPECT_LT(std::pair(sds[i - 1].sat, sds[i - 1].frequency), std::pair(sd.sat, sd.frequency));
+    if (i > 0) {
+      EXPECT_LT(std::pair(sds[i - 1].sat, sds[i - 1].frequency), std::pair(sd.sat, sd.frequency));
+    }
     EXPECT_GE(sd.elevation_rad, options.elevation_mask_rad);
     EXPECT_NEAR(sd.los_E.norm(), 1.0, 1e-12);
     EXPECT_DOUBLE_EQ(sd.code_variance_m2, sd.phase_variance_m2 * options.code_phase_ratio * options.code_phase_ratio);
@@ -73,7 +75,9 @@ TEST(SingleDifference, AnEpochDifferencedAtTheTruth) {
     EXPECT_LT(std::abs(sd.code_m - sds[0].code_m), 30.0) << sd.sat.to_string();
     const double scale = std::pow(sd.wavelength_m / first_wavelength_m(eph, sd.sat), 2);
     EXPECT_DOUBLE_EQ(sd.iono_scale, scale);
-    if (sd.frequency == 0) EXPECT_DOUBLE_EQ(sd.iono_scale, 1.0);
+    if (sd.frequency == 0) {
+      EXPECT_DOUBLE_EQ(sd.iono_scale, 1.0);
+    }
   }
   RtkOptions high_mask = options;
   high_mask.elevation_mask_rad = 45.0 * core::kDegToRad;

@@ -5,6 +5,7 @@
 // state holding the position and one ambiguity per satellite.
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,7 +34,7 @@ SyntheticEpoch synthetic_epoch(int count, const Eigen::Vector3d& offset_E_m, dou
     const double el = (80.0 - 55.0 * i / std::max(count - 1, 1)) * 0.017453292519943295;
     const double az = 2.4 * i;
     SingleDiff sd;
-    sd.sat = core::SatelliteId{core::Constellation::Gps, i + 1};
+    sd.sat = core::SatelliteId{core::Constellation::Gps, static_cast<std::uint8_t>(i + 1)};
     sd.frequency = 0;
     sd.group = 0;
     sd.wavelength_m = kWavelengthM;

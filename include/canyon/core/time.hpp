@@ -133,4 +133,11 @@ struct WeekTow {
 /// "2021-09-22 06:30:00.000" (scale as the caller knows it).
 [[nodiscard]] std::string format_calendar(const CalendarTime& c, int decimals = 3);
 
+/// "GPST 2175 369000.0": week and time of week (normalised), as logs name an epoch.
+[[nodiscard]] std::string format_gpst(const GpsTime& t, int decimals = 1);
+
+/// The system clock's time now, on the GPST scale (whole seconds; `leaps` for GPST - UTC). For a reference time
+/// near the data (RTCM 3 and week rollovers) when the data carries none.
+[[nodiscard]] GpsTime system_clock_gps(const LeapSecondTable& leaps);
+
 }  // namespace canyon::core

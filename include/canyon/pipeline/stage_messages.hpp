@@ -130,11 +130,23 @@ struct SolvedEpoch {
 };
 
 // The epoch record of any stage message.
-[[nodiscard]] inline IngestedEpoch& epoch_of(IngestedEpoch& m) { return m; }
-[[nodiscard]] inline IngestedEpoch& epoch_of(BridgedEpoch& m) { return m.epoch; }
-[[nodiscard]] inline IngestedEpoch& epoch_of(AlignedEpoch& m) { return m.bridged.epoch; }
-[[nodiscard]] inline IngestedEpoch& epoch_of(PredictedEpoch& m) { return m.aligned.bridged.epoch; }
-[[nodiscard]] inline IngestedEpoch& epoch_of(UpdatedEpoch& m) { return m.predicted.aligned.bridged.epoch; }
-[[nodiscard]] inline IngestedEpoch& epoch_of(SolvedEpoch& m) { return m.epoch(); }
+[[nodiscard]] inline IngestedEpoch& epoch_of(IngestedEpoch& m) {
+  return m;
+}
+[[nodiscard]] inline IngestedEpoch& epoch_of(BridgedEpoch& m) {
+  return m.epoch;
+}
+[[nodiscard]] inline IngestedEpoch& epoch_of(AlignedEpoch& m) {
+  return m.bridged.epoch;
+}
+[[nodiscard]] inline IngestedEpoch& epoch_of(PredictedEpoch& m) {
+  return m.aligned.bridged.epoch;
+}
+[[nodiscard]] inline IngestedEpoch& epoch_of(UpdatedEpoch& m) {
+  return m.predicted.aligned.bridged.epoch;
+}
+[[nodiscard]] inline IngestedEpoch& epoch_of(SolvedEpoch& m) {
+  return m.epoch();
+}
 
 }  // namespace canyon::pipeline
