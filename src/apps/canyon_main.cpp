@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,8 +83,8 @@ struct ProcessArgs {
   std::string pipeline = "bridge-ahead";
 };
 
-void add_process_command(CLI::App& app, ProcessArgs& args) {
-  CLI::App* cmd = app.add_subcommand("process", "Process recorded observations into a solution file (.pos)");
+/// The options of canyon process that check-fixes shares: configuration, inputs, outputs, exclusions, pipeline.
+void add_process_options(CLI::App* cmd, ProcessArgs& args) {
   cmd->add_option("--config", args.config_file, "YAML configuration (strict: unknown keys are errors)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--mode", args.mode, "Processing mode: spp, rtk or fusion (RTK aided by VIO, the paper's method)")
@@ -106,13 +107,6 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
       ->check(CLI::IsMember({"tow", "calendar"}));
   cmd->add_option("--elevation-mask-deg", args.elevation_mask_deg, "Elevation mask (deg), default 15")
       ->check(CLI::Range(0.0, 89.9));
-  cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
-  args.describe_config =
-      cmd->add_option("--describe-config", args.describe_what,
-                      "Print every configuration key with its unit, default and meaning, and exit: of canyon process "
-                      "(the default), or of rover, base or a simulation scenario")
-          ->expected(0, 1)
-          ->check(CLI::IsMember({"process", "rover", "base", "scenario"}));
   cmd->add_option("--pipeline", args.pipeline,
                   "rtk and fusion: run the six stages bridge-ahead (the default: ingest and the time bridge on a "
                   "second thread, ahead of the other four), sequential (one thread) or threaded (six threads and "
@@ -120,6 +114,18 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
       ->check(CLI::IsMember({"bridge-ahead", "sequential", "threaded"}));
   cmd->add_flag("-q,--quiet", args.quiet, "No progress bar and no summary line");
   cmd->add_flag("-v,--verbose", args.verbose, "Log why epochs got no solution or, in rtk mode, no fix (first 100)");
+}
+
+void add_process_command(CLI::App& app, ProcessArgs& args) {
+  CLI::App* cmd = app.add_subcommand("process", "Process recorded observations into a solution file (.pos)");
+  add_process_options(cmd, args);
+  cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
+  args.describe_config =
+      cmd->add_option("--describe-config", args.describe_what,
+                      "Print every configuration key with its unit, default and meaning, and exit: of canyon process "
+                      "(the default), or of rover, base or a simulation scenario")
+          ->expected(0, 1)
+          ->check(CLI::IsMember({"process", "rover", "base", "scenario"}));
 }
 
 /// Input defects are often repeated every epoch: the first few warnings, and a count of the rest ("... and N
@@ -134,8 +140,9 @@ void print_warnings(const std::vector<std::string>& warnings, bool verbose, cons
   }
 }
 
-/// --describe-config [WHAT]: the keys of a configuration, from the tables that parse it.
-int print_key_descriptions(const std::string& what) {
+/// --describe-config [WHAT]: the keys of a configuration, from the tables that parse it; process's defaults are
+/// those of `mode` (--mode; spp without it).
+int print_key_descriptions(const std::string& what, const std::string& mode) {
   namespace config = canyon::config;
   if (what == "rover") {
     std::cout << "# canyon rover --config FILE: every key (strict YAML; estimator: holds canyon process's keys)\n"
@@ -147,30 +154,30 @@ int print_key_descriptions(const std::string& what) {
     std::cout << "# canyon simulate --scenario FILE.yaml: every key (strict YAML)\n"
               << config::format_descriptions(config::describe_scenario());
   } else {
-    std::cout << "# canyon process --config FILE: every key (strict YAML; the command line overrides the file)\n"
-              << config::format_descriptions(config::describe_process_config());
+    const config::ProcessMode process_mode = config::mode_from_name(mode).value_or(config::ProcessMode::Spp);
+    std::cout << "# canyon process --config FILE: every key (strict YAML; the command line overrides the file); "
+              << "defaults of mode " << config::mode_name(process_mode)
+              << " (--mode rtk or fusion shows theirs; a file's mode: sets its defaults)\n"
+              << config::format_descriptions(config::describe_process_config(process_mode));
   }
   return 0;
 }
 
-int run_process_command(const ProcessArgs& args) {
-  using canyon::config::ProcessConfig;
-  if (args.describe_config != nullptr && args.describe_config->count() > 0) {
-    return print_key_descriptions(args.describe_what);
-  }
-  ProcessConfig config;
+/// The configuration of canyon process and check-fixes: the mode's defaults, the file, then the command line. An
+/// exit code when it cannot be built (the error printed).
+std::optional<int> build_process_config(const ProcessArgs& args, canyon::config::ProcessConfig& config) {
+  // Defaults: the recommended set-up of the mode (--mode, else the file's mode:, else spp), then the file, then the
+  // command line.
+  std::optional<canyon::config::ProcessMode> mode;
+  if (!args.mode.empty()) mode = canyon::config::mode_from_name(args.mode);  // CLI checked the name
+  config = canyon::config::process_defaults(mode.value_or(canyon::config::ProcessMode::Spp));
   if (!args.config_file.empty()) {
-    auto loaded = canyon::config::load_process_config(args.config_file);
+    auto loaded = canyon::config::load_process_config(args.config_file, mode);
     if (!loaded) {
       std::cerr << "canyon: error: " << loaded.error().to_string() << "\n";
       return kExitUsage;
     }
     config = std::move(*loaded);
-  }
-  if (!args.mode.empty()) {
-    config.mode = args.mode == "rtk"      ? canyon::config::ProcessMode::Rtk
-                  : args.mode == "fusion" ? canyon::config::ProcessMode::Fusion
-                                          : canyon::config::ProcessMode::Spp;
   }
   if (!args.rover.empty()) config.rover_obs = args.rover;
   if (!args.base.empty()) config.base_obs = args.base;
@@ -215,6 +222,16 @@ int run_process_command(const ProcessArgs& args) {
         args.time_format == "calendar" ? canyon::io::PosTimeFormat::Calendar : canyon::io::PosTimeFormat::WeekTow;
   }
   if (args.elevation_mask_deg >= 0.0) config.spp.elevation_mask_rad = args.elevation_mask_deg * canyon::core::kDegToRad;
+  return std::nullopt;
+}
+
+int run_process_command(const ProcessArgs& args) {
+  using canyon::config::ProcessConfig;
+  if (args.describe_config != nullptr && args.describe_config->count() > 0) {
+    return print_key_descriptions(args.describe_what, args.mode);
+  }
+  ProcessConfig config;
+  if (const std::optional<int> exit = build_process_config(args, config)) return *exit;
   if (args.print_config) {
     std::cout << canyon::config::to_yaml(config);
     return 0;

@@ -94,8 +94,28 @@ const Table<ProcessConfig>& process_table() {
   return table;
 }
 
-std::vector<KeyDescription> describe_process_config() {
-  return describe_keys(process_table(), ProcessConfig{}, Numbers::Digits12);
+std::vector<KeyDescription> describe_process_config(ProcessMode mode) {
+  return describe_keys(process_table(), process_defaults(mode), Numbers::Digits12);
+}
+
+ProcessConfig process_defaults(ProcessMode mode) {
+  ProcessConfig c;
+  c.mode = mode;
+  if (mode == ProcessMode::Fusion) {
+    c.rtk.ar_mode = rtk::ArMode::FixAndHold;
+    c.rtk.ionosphere = rtk::IonosphereModel::Estimate;
+    c.rtk.float_consistency_level = 0.001;
+    c.rtk.snr_weighting = true;
+    c.rtk.ambiguity_noise_cyc = 0.01;
+  }
+  return c;
+}
+
+std::optional<ProcessMode> mode_from_name(const std::string& name) {
+  for (const ProcessMode mode : {ProcessMode::Spp, ProcessMode::Rtk, ProcessMode::Fusion}) {
+    if (name == mode_name(mode)) return mode;
+  }
+  return std::nullopt;
 }
 
 std::string mode_name(ProcessMode mode) {
@@ -147,21 +167,33 @@ bool operator==(const ProcessConfig& a, const ProcessConfig& b) {
   return equal_keys(process_table(), a, b);
 }
 
-Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file, ProcessConfig defaults) {
-  ProcessConfig c = std::move(defaults);
+namespace {
+
+/// The node's `mode:` when it names one (a bad value is reported by the table's codec), else spp.
+ProcessMode mode_of(const YAML::Node& node) {
+  if (!node.IsMap() || !node["mode"] || !node["mode"].IsScalar()) return ProcessMode::Spp;
+  return mode_from_name(node["mode"].Scalar()).value_or(ProcessMode::Spp);
+}
+
+}  // namespace
+
+Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file,
+                                           std::optional<ProcessMode> mode) {
+  ProcessConfig c = process_defaults(mode.value_or(mode_of(node)));
   YamlMap top(node, file);
   read_keys(process_table(), top, c);
   if (Status s = top.status(); !s) return s.error();
+  if (mode) c.mode = *mode;
   if (const std::string e = c.spp.validate(); !e.empty()) return Error{"spp: " + e, file, 0};
   if (const std::string e = c.rtk.validate(); !e.empty()) return Error{"rtk: " + e, file, 0};
   if (const std::string e = c.fusion.validate(); !e.empty()) return Error{"fusion: " + e, file, 0};
   return c;
 }
 
-Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig defaults) {
+Result<ProcessConfig> load_process_config(const std::string& path, std::optional<ProcessMode> mode) {
   auto node = load_yaml_file(path);
   if (!node) return node.error();
-  return parse_process_config(*node, path, std::move(defaults));
+  return parse_process_config(*node, path, mode);
 }
 
 std::string to_yaml(const ProcessConfig& c) {

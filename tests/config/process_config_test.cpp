@@ -76,25 +76,40 @@ TEST(ProcessConfigTest, DatasetConfigLoadsAndNamesTheDatasetsFiles) {
 }
 
 TEST(ProcessConfigTest, DefaultsMatchTheDocumentedFiles) {
-  auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/spp.yaml");
-  ASSERT_TRUE(config.ok()) << config.error().to_string();
-  EXPECT_EQ(*config, ProcessConfig{});
-  auto rtk = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/rtk.yaml");
-  ASSERT_TRUE(rtk.ok()) << rtk.error().to_string();
-  ProcessConfig expected;
-  expected.mode = ProcessMode::Rtk;
-  EXPECT_EQ(to_yaml(*rtk), to_yaml(expected));
-  // config/fusion.yaml: every fusion key at its default; the rtk section sets what it says.
-  auto fusion = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/fusion.yaml");
-  ASSERT_TRUE(fusion.ok()) << fusion.error().to_string();
-  ProcessConfig expected_fusion;
-  expected_fusion.mode = ProcessMode::Fusion;
-  expected_fusion.rtk.ar_mode = rtk::ArMode::FixAndHold;
-  expected_fusion.rtk.ionosphere = rtk::IonosphereModel::Estimate;
-  expected_fusion.rtk.float_consistency_level = 0.001;
-  expected_fusion.rtk.snr_weighting = true;
-  expected_fusion.rtk.ambiguity_noise_cyc = 0.01;
-  EXPECT_EQ(to_yaml(*fusion), to_yaml(expected_fusion));
+  // One source of defaults: each shipped file is its mode's process_defaults(), key for key.
+  for (const auto& [file, mode] : {std::pair{"spp.yaml", ProcessMode::Spp}, std::pair{"rtk.yaml", ProcessMode::Rtk},
+                                   std::pair{"fusion.yaml", ProcessMode::Fusion}}) {
+    auto config = load_process_config(std::string(CANYON_SOURCE_DIR) + "/config/" + file);
+    ASSERT_TRUE(config.ok()) << config.error().to_string();
+    EXPECT_EQ(*config, process_defaults(mode)) << file;
+    EXPECT_EQ(to_yaml(*config), to_yaml(process_defaults(mode))) << file;
+  }
+  // The fusion defaults are the RTK engine as the fusion runs it, not the rtk mode's.
+  const ProcessConfig fusion = process_defaults(ProcessMode::Fusion);
+  EXPECT_EQ(fusion.rtk.ar_mode, rtk::ArMode::FixAndHold);
+  EXPECT_EQ(fusion.rtk.ionosphere, rtk::IonosphereModel::Estimate);
+  EXPECT_TRUE(fusion.rtk.snr_weighting);
+  EXPECT_EQ(process_defaults(ProcessMode::Rtk).rtk.ar_mode, rtk::ArMode::Continuous);
+}
+
+TEST(ProcessConfigTest, AFilesModeOrTheCommandLinesSetsTheDefaults) {
+  // A sparse file takes the defaults of its mode: ...
+  auto sparse = parse("mode: fusion\nrtk:\n  ratio_threshold: 2.5\n");
+  ASSERT_TRUE(sparse.ok()) << sparse.error().to_string();
+  ProcessConfig expected = process_defaults(ProcessMode::Fusion);
+  expected.rtk.ratio_threshold = 2.5;
+  EXPECT_EQ(*sparse, expected);
+  // ... or of the command line's --mode, which overrides the file's.
+  auto overridden = parse_process_config(YAML::Load("mode: rtk\n"), "test.yaml", ProcessMode::Fusion);
+  ASSERT_TRUE(overridden.ok()) << overridden.error().to_string();
+  EXPECT_EQ(*overridden, process_defaults(ProcessMode::Fusion));
+  auto none = parse("rtk:\n  ratio_threshold: 2.5\n");
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(none->mode, ProcessMode::Spp);
+  EXPECT_EQ(none->rtk.ar_mode, rtk::ArMode::Continuous);
+  EXPECT_FALSE(parse("mode: fusoin\n").ok());
+  EXPECT_EQ(mode_from_name("fusion"), ProcessMode::Fusion);
+  EXPECT_EQ(mode_from_name("fusoin"), std::nullopt);
 }
 
 TEST(ProcessConfigTest, FusionOptionsParseValidateAndRoundTrip) {

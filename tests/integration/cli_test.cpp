@@ -89,6 +89,22 @@ TEST(CanyonCli, PrintConfigShowsEffectiveOptions) {
   EXPECT_NE(r.output.find("coordinates: ecef"), std::string::npos) << r.output;
 }
 
+// Without --config a mode runs its recommended set-up: the shipped file of that mode, key for key.
+TEST(CanyonCli, ModeWithoutConfigIsTheShippedFile) {
+  for (const std::string mode : {"rtk", "fusion"}) {
+    const auto defaults = canyon("process --mode " + mode + " --print-config");
+    const auto shipped =
+        canyon("process --config " + std::string(CANYON_SOURCE_DIR) + "/config/" + mode + ".yaml --print-config");
+    EXPECT_EQ(defaults.exit_code, 0) << defaults.output;
+    EXPECT_EQ(shipped.exit_code, 0) << shipped.output;
+    EXPECT_EQ(defaults.output, shipped.output) << mode;
+  }
+  const auto fusion = canyon("process --mode fusion --print-config");
+  EXPECT_NE(fusion.output.find("ar_mode: fix_and_hold"), std::string::npos) << fusion.output;
+  const auto described = canyon("process --mode fusion --describe-config");
+  EXPECT_NE(described.output.find("defaults of mode fusion"), std::string::npos) << described.output;
+}
+
 TEST(CanyonCli, ProcessesRealDataAndSummarises) {
   if (!fs::exists(kGsiRover)) GTEST_SKIP() << "shared dataset not present: " << kGsiRover;
   const fs::path out = test::temp_dir("cli") / "gsi.pos";

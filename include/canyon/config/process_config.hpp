@@ -53,14 +53,23 @@ struct ProcessConfig {
 /// Equal when every key of the tables is (the member itself where it can be compared, else its YAML form).
 [[nodiscard]] bool operator==(const ProcessConfig& a, const ProcessConfig& b);
 
-/// Parses a YAML node; `file` names the source in errors and anchors relative paths.
+/// The recommended set-up of each mode, the one source of `canyon process`'s defaults: ProcessConfig{} with `mode`,
+/// and for fusion the RTK engine as the paper's fusion runs it (fix-and-hold, estimated ionosphere, C/N0 weights, the
+/// float's consistency test, an ambiguity random walk of 0.01 cycles per sqrt(s)). config/spp.yaml, rtk.yaml and
+/// fusion.yaml are these, key for key (tests/config/process_config_test.cpp).
+[[nodiscard]] ProcessConfig process_defaults(ProcessMode mode);
+
+/// Parses a YAML node over process_defaults() of its mode: `mode` when given (the command line's --mode), else the
+/// node's `mode:` key, else spp. `file` names the source in errors and anchors relative paths.
 Result<ProcessConfig> parse_process_config(const YAML::Node& node, const std::string& file,
-                                           ProcessConfig defaults = {});
-Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig defaults = {});
+                                           std::optional<ProcessMode> mode = std::nullopt);
+Result<ProcessConfig> load_process_config(const std::string& path, std::optional<ProcessMode> mode = std::nullopt);
 /// The configuration as YAML that parse_process_config() reads back to an equal configuration.
 [[nodiscard]] std::string to_yaml(const ProcessConfig& config);
 
 [[nodiscard]] std::string mode_name(ProcessMode mode);
+/// The mode named `name` (spp, rtk, fusion), nullopt for any other.
+[[nodiscard]] std::optional<ProcessMode> mode_from_name(const std::string& name);
 
 /// The keys of each section (options_table.hpp): spp:, rtk:, fusion: (flat keys over the per-piece structs), and the
 /// whole configuration with those as sections.
@@ -68,7 +77,7 @@ Result<ProcessConfig> load_process_config(const std::string& path, ProcessConfig
 [[nodiscard]] const Table<rtk::RtkOptions>& rtk_table();
 [[nodiscard]] const Table<fusion::FusionOptions>& fusion_table();
 [[nodiscard]] const Table<ProcessConfig>& process_table();
-/// Every key with its unit, default (of ProcessConfig{}) and doc.
-[[nodiscard]] std::vector<KeyDescription> describe_process_config();
+/// Every key with its unit, default (of process_defaults(mode)) and doc.
+[[nodiscard]] std::vector<KeyDescription> describe_process_config(ProcessMode mode = ProcessMode::Spp);
 
 }  // namespace canyon::config
