@@ -298,6 +298,36 @@ std::string gps_text(const core::GpsTime& t) {
   return buffer;
 }
 
+/// The VIO track's rate and segment breaks: one line for the rate, the first kMaxSegmentNotes breaks, then one line
+/// counting the rest by kind (a stream at the wrong rate or with many breaks says so in a few lines).
+void report_vio_segments(const fusion::VioTrack& track, const fusion::VioTrackOptions& options,
+                         const std::vector<std::string>& notes, ProcessSummary& summary) {
+  constexpr std::size_t kMaxSegmentNotes = 10;
+  const double interval_s = fusion::median_interval_s(track.samples());
+  if (interval_s > 0.0) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "fusion: VIO poses every %.3f s (%.1f Hz, median): a gap is longer than %.2f s (vio_max_gap_s or "
+                  "%.0f intervals); %d VIO segment(s)",
+                  interval_s, 1.0 / interval_s, std::max(options.max_gap_s, fusion::kGapIntervals * interval_s),
+                  fusion::kGapIntervals, track.segments());
+    summary.report.emplace_back(line);
+  }
+  for (std::size_t i = 0; i < notes.size() && i < kMaxSegmentNotes; ++i)
+    summary.report.push_back("fusion: " + notes[i]);
+  if (notes.size() <= kMaxSegmentNotes) return;
+  int gaps = 0;
+  int jumps = 0;
+  for (std::size_t i = kMaxSegmentNotes; i < notes.size(); ++i) {
+    if (notes[i].rfind("VIO gap", 0) == 0) ++gaps;
+    if (notes[i].rfind("VIO jump", 0) == 0) ++jumps;
+  }
+  const auto rest = static_cast<int>(notes.size() - kMaxSegmentNotes);
+  summary.report.push_back("fusion: ... and " + std::to_string(rest) + " more VIO segment breaks (" +
+                           std::to_string(gaps) + " gaps, " + std::to_string(jumps) + " jumps, " +
+                           std::to_string(rest - gaps - jumps) + " covariance resets)");
+}
+
 /// The VIO track with the causal time bridge (fusion.timesync_mode: causal): every pose mapped as the live rover maps
 /// it (fusion::CausalTimeBridge), so that `canyon process` reproduces a rover fed over DDS.
 Result<fusion::VioTrack> load_vio_causal(const config::ProcessConfig& config, const io::VioFile& vio,
@@ -315,6 +345,7 @@ Result<fusion::VioTrack> load_vio_causal(const config::ProcessConfig& config, co
     }
   }
   fusion::VioTrack track = fusion::VioTrack::streaming(config.fusion.vio);
+  std::vector<std::string> notes;
   int unmapped = 0;
   for (const io::VioRecord& record : vio.records) {
     auto t = bridge.to_gps(record.t_ns);
@@ -327,13 +358,14 @@ Result<fusion::VioTrack> load_vio_causal(const config::ProcessConfig& config, co
     }
     std::string note;
     (void)track.append(record, *t, &note);  // a fit cannot reorder poses a few ms apart; if it did, dropped
-    if (!note.empty()) summary.report.push_back("fusion: " + note);
+    if (!note.empty()) notes.push_back(note);
   }
   if (unmapped > 0) {
     summary.report.push_back("fusion: " + std::to_string(unmapped) +
                              " VIO poses before the causal time bridge had its pairs (not used)");
   }
   if (track.empty()) return Error{"no VIO pose mapped to GPST by the causal time bridge", config.vio, 0};
+  report_vio_segments(track, config.fusion.vio, notes, summary);
   if (const std::optional<fusion::TimeBridgeFit>& fit = bridge.fit()) {
     char line[200];
     std::snprintf(line, sizeof line,
@@ -389,7 +421,7 @@ Result<fusion::VioTrack> load_vio(const config::ProcessConfig& config, ProcessSu
   std::vector<std::string> notes;
   auto track = fusion::VioTrack::build(*vio, bridge, config.fusion.vio, notes);
   if (!track) return Error{track.error().message, config.vio, 0};
-  for (const std::string& n : notes) summary.report.push_back("fusion: " + n);
+  report_vio_segments(*track, config.fusion.vio, notes, summary);
   return track;
 }
 

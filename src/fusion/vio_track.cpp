@@ -27,15 +27,39 @@ std::string VioTrackOptions::validate() const {
   return {};
 }
 
-std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options) {
+double PoseIntervals::nominal_s(double dt_s) const {
+  if (recent_.empty()) return std::min(dt_s, 1.0);
+  std::vector<double> sorted = recent_;
+  const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>((sorted.size() - 1) / 2);
+  std::nth_element(sorted.begin(), middle, sorted.end());
+  return *middle;
+}
+
+void PoseIntervals::add(double dt_s) {
+  if (recent_.size() == static_cast<std::size_t>(kWindow)) recent_.erase(recent_.begin());
+  recent_.push_back(dt_s);
+}
+
+double median_interval_s(const std::vector<VioTrackSample>& samples) {
+  if (samples.size() < 2) return 0.0;
+  std::vector<double> dt;
+  dt.reserve(samples.size() - 1);
+  for (std::size_t k = 1; k < samples.size(); ++k) dt.push_back(samples[k].t_s - samples[k - 1].t_s);
+  const auto middle = dt.begin() + static_cast<std::ptrdiff_t>((dt.size() - 1) / 2);
+  std::nth_element(dt.begin(), middle, dt.end());
+  return *middle;
+}
+
+std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options,
+                          double nominal_interval_s) {
   const double dt_s = s.t_s - prev.t_s;
   const double jump_m = (s.T_OI.p - prev.T_OI.p).norm();
   const double turn_deg = core::so3_log(prev.T_OI.q.conjugate() * s.T_OI.q).norm() * core::kRadToDeg;
   const double trace = s.P.topLeftCorner<3, 3>().trace();
   const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
   char buffer[160];
-  if (dt_s > options.max_gap_s) {
-    std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s", dt_s);
+  if (dt_s > std::max(options.max_gap_s, kGapIntervals * nominal_interval_s)) {
+    std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s (poses %.2f s apart before it)", dt_s, nominal_interval_s);
     return buffer;
   }
   if (jump_m > options.max_speed_mps * dt_s || turn_deg > options.max_rotation_rate_dps * dt_s) {
@@ -52,15 +76,18 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
 
 namespace {
 
-/// Gives `s` its segment after `prev` (nullptr: the first sample); the reason and the new segment in `note`.
+/// Gives `s` its segment after `prev` (nullptr: the first sample), its interval judged against `intervals` (which
+/// it joins); the reason and the new segment in `note`.
 void place_in_segment(const VioTrackSample* prev, VioTrackSample& s, const VioTrackOptions& options,
-                      const core::GpsTime& reference, std::string* note) {
+                      PoseIntervals& intervals, const core::GpsTime& reference, std::string* note) {
   if (prev == nullptr) {
     s.segment = 0;
     s.C_previous.setZero();
     return;
   }
-  const std::string why = segment_break(*prev, s, options);
+  const double dt_s = s.t_s - prev->t_s;
+  const std::string why = segment_break(*prev, s, options, intervals.nominal_s(dt_s));
+  intervals.add(dt_s);
   s.segment = prev->segment;
   if (why.empty()) return;
   s.segment = prev->segment + 1;
@@ -75,9 +102,10 @@ void place_in_segment(const VioTrackSample* prev, VioTrackSample& s, const VioTr
 
 void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
                      const core::GpsTime& reference, std::vector<std::string>* notes) {
+  PoseIntervals intervals;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     std::string note;
-    place_in_segment(k == 0 ? nullptr : &samples[k - 1], samples[k], options, reference, &note);
+    place_in_segment(k == 0 ? nullptr : &samples[k - 1], samples[k], options, intervals, reference, &note);
     if (notes != nullptr && !note.empty()) notes->push_back(note);
   }
 }
@@ -122,7 +150,7 @@ bool VioTrack::append(const io::VioRecord& record, const core::GpsTime& t, std::
   s.P = record.covariance;
   if (options_.use_cross_covariance && record.cross_previous) s.C_previous = *record.cross_previous;
   s.line = record.line;
-  place_in_segment(samples_.empty() ? nullptr : &samples_.back(), s, options_, reference_, note);
+  place_in_segment(samples_.empty() ? nullptr : &samples_.back(), s, options_, intervals_, reference_, note);
   samples_.push_back(s);
   return true;
 }

@@ -122,6 +122,47 @@ std::vector<VioTrackSample> straight_samples(int n, double dt_s, double speed_mp
   return s;
 }
 
+// A VIO stream is used at its own rate: 1 Hz and 2 Hz poses are one segment, a gap is judged against their interval,
+// a 10 Hz stream keeps vio_max_gap_s; streaming gives the same segments as the whole file.
+TEST(VioTrackTest, GapsAreJudgedAgainstTheStreamsOwnRate) {
+  const core::GpsTime ref{2266, 100.0};
+  for (const double dt_s : {1.0, 0.5}) {
+    std::vector<VioTrackSample> s = straight_samples(60, dt_s, 1.4);
+    EXPECT_EQ(VioTrack::from_samples(s, ref).segments(), 1) << dt_s;
+    EXPECT_NEAR(median_interval_s(s), dt_s, 1e-12);
+    for (std::size_t k = 30; k < s.size(); ++k) s[k].t_s += 4.0 * dt_s;  // 5 intervals: a gap
+    const VioTrack whole = VioTrack::from_samples(s, ref);
+    EXPECT_EQ(whole.segments(), 2) << dt_s;
+    EXPECT_EQ(whole.samples()[30].segment, 1);
+    VioTrack live = VioTrack::streaming({});
+    std::vector<std::string> notes;
+    for (const VioTrackSample& v : s) {
+      io::VioRecord r;
+      r.T_OI = v.T_OI;
+      r.covariance = v.P;
+      std::string note;
+      ASSERT_TRUE(live.append(r, ref + v.t_s, &note));
+      if (!note.empty()) notes.push_back(note);
+    }
+    EXPECT_EQ(live.segments(), 2);
+    ASSERT_EQ(notes.size(), 1U);
+    EXPECT_NE(notes[0].find("VIO gap of"), std::string::npos) << notes[0];
+    // Between two 1 Hz poses the track interpolates.
+    EXPECT_TRUE(whole.pose_at(ref + 10.5 * dt_s).has_value());
+  }
+  std::vector<VioTrackSample> fast = straight_samples(60, 0.1, 1.4);
+  for (std::size_t k = 30; k < fast.size(); ++k) fast[k].t_s += 0.35;  // 0.45 s: under vio_max_gap_s (0.5 s)
+  EXPECT_EQ(VioTrack::from_samples(fast, ref).segments(), 1);
+  for (std::size_t k = 40; k < fast.size(); ++k) fast[k].t_s += 0.5;  // 0.6 s: a gap
+  EXPECT_EQ(VioTrack::from_samples(fast, ref).segments(), 2);
+  // A stream that slows from 10 Hz to 1 Hz: gaps until the median follows, then one segment again.
+  std::vector<VioTrackSample> slowing = straight_samples(100, 0.1, 1.4);
+  for (std::size_t k = 50; k < slowing.size(); ++k) slowing[k].t_s = slowing[49].t_s + (k - 49.0);
+  const VioTrack slowed = VioTrack::from_samples(slowing, ref);
+  EXPECT_LE(slowed.segments(), 12);
+  EXPECT_EQ(slowed.samples()[99].segment, slowed.samples()[80].segment);
+}
+
 TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   std::vector<VioTrackSample> s = straight_samples(40, 0.1, 1.4);
   for (int k = 10; k < 40; ++k) s[static_cast<std::size_t>(k)].t_s += 1.0;           // a 1.1 s gap before sample 10

@@ -2,7 +2,9 @@
 // The VIO trajectory on GPST: poses T_OI with their covariances, split into segments, interpolated on SE(3) at
 // GNSS epochs with the joint covariance of two interpolated poses.
 //
-// Segments. A new segment starts at a pose that is more than max_gap_s after the previous one (a gap), whose
+// Segments. A new segment starts at a pose that is further from the previous one than a gap's threshold, the larger
+// of max_gap_s and kGapIntervals times the stream's own pose interval (the median of the last intervals, so that a
+// 1 Hz or 2 Hz VIO stream is used as it comes and a 10 Hz one keeps max_gap_s) (a gap), whose
 // implied speed or rotation rate from the previous one exceeds max_speed_mps or max_rotation_rate_dps (a jump: the
 // VIO reset or relocalised its odometry frame), or whose position covariance collapsed (trace below
 // reset_covariance_ratio times the previous one's: the VIO restarted its covariance with its frame). T_EO belongs to
@@ -48,6 +50,22 @@ struct VioTrackOptions {
   bool use_cross_covariance = true;      ///< false: consecutive-pose cross-covariances taken as zero
 
   [[nodiscard]] std::string validate() const;
+};
+
+/// A gap is longer than this many of the stream's own pose intervals (and than max_gap_s).
+inline constexpr double kGapIntervals = 3.0;
+
+/// The stream's own pose interval, to judge gaps by: the median of the last kWindow intervals between poses.
+class PoseIntervals {
+ public:
+  static constexpr int kWindow = 21;
+  /// The interval before `dt_s` joins: the median of those seen; for the first, dt_s up to 1 s (a stream of 1 Hz
+  /// and faster is taken at its rate; a longer first interval is judged against 1 s).
+  [[nodiscard]] double nominal_s(double dt_s) const;
+  void add(double dt_s);
+
+ private:
+  std::vector<double> recent_;  // at most kWindow, oldest first
 };
 
 struct VioTrackSample {
@@ -116,11 +134,17 @@ class VioTrack {
   std::vector<VioTrackSample> samples_;
   core::GpsTime reference_;
   VioTrackOptions options_;
-  int forgotten_ = 0;  // samples forgotten from the front: samples_[0] has index forgotten_
+  PoseIntervals intervals_;  // of the appended poses (streaming)
+  int forgotten_ = 0;        // samples forgotten from the front: samples_[0] has index forgotten_
 };
 
-/// Why `next` starts a new segment after `previous` (a gap, a jump, a covariance reset), empty if it does not.
-std::string segment_break(const VioTrackSample& previous, const VioTrackSample& next, const VioTrackOptions& options);
+/// Why `next` starts a new segment after `previous` (a gap, a jump, a covariance reset), empty if it does not; a gap
+/// is judged against max(options.max_gap_s, kGapIntervals nominal_interval_s).
+std::string segment_break(const VioTrackSample& previous, const VioTrackSample& next, const VioTrackOptions& options,
+                          double nominal_interval_s = 0.0);
+
+/// The median interval between consecutive samples (0 with fewer than two): the stream's rate, for reports.
+[[nodiscard]] double median_interval_s(const std::vector<VioTrackSample>& samples);
 
 /// Splits samples into segments (gaps, jumps, covariance resets), appending a note for each break.
 void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
