@@ -15,6 +15,7 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include "canyon/commands/check_fixes.hpp"
 #include "canyon/commands/convert.hpp"
 #include "canyon/commands/demo.hpp"
 #include "canyon/commands/evaluate.hpp"
@@ -26,6 +27,9 @@
 #include "canyon/config/scenario_config.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/satellite.hpp"
+#include "canyon/core/solution.hpp"
+#include "canyon/eval/leave_out.hpp"
+#include "canyon/io/pos_file.hpp"
 
 #include "main_guard.hpp"
 
@@ -280,6 +284,62 @@ int run_process_command(const ProcessArgs& args) {
                  summary->epochs, summary->solved, percent, fixed.c_str(), summary->wall_s, config.out.c_str());
   }
   return summary->solved > 0 ? 0 : kExitInput;
+}
+
+struct CheckFixesArgs {
+  ProcessArgs process;
+  canyon::commands::CheckFixesOptions options;
+  std::string reference;  ///< another solution (.pos, e.g. RTKLIB's) whose fixed epochs are counted beside canyon's
+};
+
+void add_check_fixes_command(CLI::App& app, CheckFixesArgs& args) {
+  CLI::App* cmd = app.add_subcommand(
+      "check-fixes",
+      "Check fixes without ground truth: solve again with the 1..N most-observed satellites left out and compare the "
+      "fixes at the epochs fixed in both (a fix that moves is wrong in one of the two). Exit 3 when a run agrees at "
+      "fewer than --min-agreement of its epochs");
+  add_process_options(cmd, args.process);
+  cmd->add_option("--leave-out", args.options.max_left_out, "Runs leaving out 1..N most-observed satellites (3)")
+      ->check(CLI::Range(1, 10));
+  cmd->add_option("--tolerance-m", args.options.tolerance_m, "A fix agrees within this 3-D distance (m, 0.05)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--min-agreement", args.options.min_agreement, "Share of agreeing epochs a run needs (0.95)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--reference", args.reference,
+                  "Another solution of the same input (.pos, e.g. RTKLIB's): its fixed epochs are counted beside "
+                  "canyon's")
+      ->check(CLI::ExistingFile);
+}
+
+int run_check_fixes_command(const CheckFixesArgs& args) {
+  canyon::config::ProcessConfig config;
+  if (const std::optional<int> exit = build_process_config(args.process, config)) return *exit;
+  const bool quiet = args.process.quiet;
+  auto result = canyon::commands::check_fixes(config, args.options, [quiet](const std::string& run) {
+    if (!quiet) std::fprintf(stderr, "canyon check-fixes: %s ...\n", run.c_str());
+  });
+  if (!result) {
+    std::cerr << "canyon: error: " << result.error().to_string() << "\n";
+    return kExitInput;
+  }
+  print_warnings(result->full.warnings, args.process.verbose, "more input warnings");
+  std::printf("%s: %d epochs, %d fixed (%.1f %%)\n", config.out.c_str(), result->full.epochs, result->full.fixed,
+              result->full.epochs > 0 ? 100.0 * result->full.fixed / result->full.epochs : 0.0);
+  if (!args.reference.empty()) {
+    auto reference = canyon::io::read_pos_file(args.reference);
+    if (!reference) {
+      std::cerr << "canyon: error: " << reference.error().to_string() << "\n";
+      return kExitInput;
+    }
+    const auto fixed = std::count_if(reference->begin(), reference->end(), [](const canyon::core::Solution& s) {
+      return s.status == canyon::core::SolutionStatus::Fixed;
+    });
+    std::printf("%s: %ld fixed; canyon fixes %.2f times as many\n", args.reference.c_str(), static_cast<long>(fixed),
+                fixed > 0 ? static_cast<double>(result->full.fixed) / static_cast<double>(fixed) : 0.0);
+  }
+  std::printf("%s", canyon::eval::format_leave_out(result->runs, args.options.min_agreement).c_str());
+  constexpr int kExitInconsistent = 3;
+  return result->consistent(args.options.min_agreement) ? 0 : kExitInconsistent;
 }
 
 struct SimulateArgs {
@@ -591,6 +651,8 @@ int run_main(int argc, char** argv) {
   add_demo_command(app, demo_args);
   ConvertArgs convert_args;
   add_convert_command(app, convert_args);
+  CheckFixesArgs check_fixes_args;
+  add_check_fixes_command(app, check_fixes_args);
   // Listed for --help only: `canyon base ...` runs canyon-base before the command line is parsed (main()).
   app.add_subcommand("base",
                      "Base station publishing RTCM 3 on DDS, NTRIP and TCP (runs canyon-base; canyon base --help)")
@@ -623,6 +685,7 @@ int run_main(int argc, char** argv) {
   if (app.got_subcommand("evaluate")) return run_evaluate_command(evaluate_args);
   if (app.got_subcommand("demo")) return run_demo_command(demo_args);
   if (app.got_subcommand("convert")) return run_convert_command(convert_args);
+  if (app.got_subcommand("check-fixes")) return run_check_fixes_command(check_fixes_args);
   return kExitUsage;
 }
 
