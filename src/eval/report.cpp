@@ -166,6 +166,11 @@ void append_ape_rows(std::vector<TableRow>& rows, const EvaluationReport& report
   }
 }
 
+/// Fixed epochs within the wrong-fix threshold of the truth: the correct-fix rate's numerator (over all epochs).
+int correct_fixes(const SolutionStats& st) {
+  return st.fixed().error.count - st.wrong_fixes;
+}
+
 std::vector<TableRow> table_rows(const EvaluationReport& report) {
   std::vector<TableRow> rows;
   const int epochs = report.epochs.epochs;
@@ -184,6 +189,8 @@ std::vector<TableRow> table_rows(const EvaluationReport& report) {
                        if (!s.wrong_fix_rate) return std::to_string(s.stats.wrong_fixes);
                        return format("%d (%.2f)", s.stats.wrong_fixes, 100.0 * *s.wrong_fix_rate);
                      }));
+  rows.push_back(row(format("correct fixes <= %.2f m (%%)", report.wrong_fix_threshold_m), report,
+                     [&](const SolutionReport& s) { return count_and_percent(correct_fixes(s.stats), epochs); }));
   rows.push_back(row("epochs without truth", report,
                      [](const SolutionReport& s) { return std::to_string(s.stats.epochs_without_truth); }));
   rows.push_back(row("time to first fix (s)", report, [](const SolutionReport& s) -> std::string {
@@ -274,6 +281,8 @@ std::string json_solution(const SolutionReport& r, int epochs) {
   out += "},\n";
   out += "      \"wrong_fixes\": " + std::to_string(st.wrong_fixes) + ",\n";
   out += "      \"wrong_fix_rate\": " + json_optional(r.wrong_fix_rate) + ",\n";
+  out += "      \"correct_fixes\": " + std::to_string(correct_fixes(st)) + ",\n";
+  out += "      \"correct_fix_rate\": " + rate(correct_fixes(st)) + ",\n";
   out += "      \"epochs_with_truth\": " + std::to_string(st.epochs_with_truth) + ",\n";
   out += "      \"epochs_without_truth\": " + std::to_string(st.epochs_without_truth) + ",\n";
   out += "      \"time_to_first_fix_s\": " + json_optional(st.time_to_first_fix_s) + ",\n";

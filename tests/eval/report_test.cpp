@@ -222,6 +222,7 @@ TEST(Report, TextTableSideBySide) {
                        "single (%)                           1 (10.00) :  0 (0.00)\n"
                        "fill-in (%)                          2 (20.00) :  0 (0.00)\n"
                        "wrong fixes > 0.10 m (% of fixed)    1 (20.00) :  0 (0.00)\n"
+                       "correct fixes <= 0.10 m (%)          4 (40.00) : 6 (60.00)\n"
                        "epochs without truth                         2 :         0\n"
                        "time to first fix (s)                      2.0 :       2.0\n"
                        "APE 3D, all epochs (m)\n"
@@ -259,7 +260,8 @@ TEST(Report, MarkdownAndJson) {
        {"\"format\": \"canyon-evaluate/1\"", "\"kind\": \"trajectory\", \"samples\": 8",
         "\"epochs\": {\"count\": 10, \"source\": \"truth+solutions\"}", "\"label\": \"A\"",
         "\"fixed\": {\"epochs\": 6, \"rate\": 0.6}", "\"fill_in\": {\"epochs\": 2, \"rate\": 0.2}",
-        "\"wrong_fixes\": 1", "\"wrong_fix_rate\": 0.2", "\"epochs_without_truth\": 2", "\"time_to_first_fix_s\": 2",
+        "\"wrong_fixes\": 1", "\"wrong_fix_rate\": 0.2", "\"correct_fixes\": 4", "\"correct_fix_rate\": 0.4",
+        "\"epochs_without_truth\": 2", "\"time_to_first_fix_s\": 2",
         "\"other\": {\"epochs\": 0, \"3d\": null, \"horizontal\": null, \"vertical_rmse_m\": null}",
         "\"max_m\": 0.15, \"p95_m\": 0.13"}) {
     EXPECT_NE(json.find(expected), std::string::npos) << expected << "\n" << json;
