@@ -322,6 +322,10 @@ const Table<sim::ReflectionOptions>& reflections_table() {
       {"wall_loss_db", "dB", "wall reflection power below the direct signal", at(&R::wall_loss_db)},
       {"nlos_extra_loss_db", "dB", "extra loss of a reflection received without the direct signal",
        at(&R::nlos_extra_loss_db)},
+      {"nlos_loss_spread_db", "dB",
+       "1-sigma spread of an NLOS signal's loss, drawn per satellite and wall (0: every NLOS signal exactly "
+       "wall_loss_db + nlos_extra_loss_db down)",
+       at(&R::nlos_loss_spread_db)},
       {"ground_loss_db", "dB", "ground reflection power below the direct signal", at(&R::ground_loss_db)},
       {"max_wall_distance_m", "m", "walls further from the antenna reflect nothing", at(&R::max_wall_distance_m)},
   };
@@ -373,6 +377,11 @@ const Table<sim::VioOptions>& vio_table() {
       {"device_clock_offset_s", "s", "device clock reading at the start", at(&V::device_clock_offset_s)},
       {"device_clock_drift_ppm", "ppm", "device clock rate error", at(&V::device_clock_drift_ppm)},
       {"timesync_jitter_s", "s", "jitter of the built-in GPS time-sync pairs, 1 sigma", at(&V::timesync_jitter_s)},
+      {"scale_error", "", "VIO translation scale error (0.005: every increment 0.5 % long), not in its covariance",
+       at(&V::scale_error)},
+      {"covariance_optimism", "",
+       "the reported covariance is the drift model's over this squared (2: sigmas half the true ones)",
+       at(&V::covariance_optimism)},
   };
   return table;
 }

@@ -212,6 +212,7 @@ std::string Scenario::validate() const {
   check_receiver(base_receiver, "base_receiver", r);
   r.non_negative(reflections.wall_loss_db, "reflections.wall_loss_db");
   r.non_negative(reflections.nlos_extra_loss_db, "reflections.nlos_extra_loss_db");
+  r.range(reflections.nlos_loss_spread_db, 0.0, 20.0, "reflections.nlos_loss_spread_db");
   r.non_negative(reflections.ground_loss_db, "reflections.ground_loss_db");
   r.non_negative(reflections.max_wall_distance_m, "reflections.max_wall_distance_m");
   check_atmosphere(atmosphere, r);
@@ -229,6 +230,8 @@ std::string Scenario::validate() const {
   r.range(vio.device_clock_offset_s, 0.0, 1e8, "vio.device_clock_offset_s");
   r.range(vio.device_clock_drift_ppm, -1000.0, 1000.0, "vio.device_clock_drift_ppm");
   r.range(vio.timesync_jitter_s, 0.0, 1.0, "vio.timesync_jitter_s");
+  r.range(vio.scale_error, -0.1, 0.1, "vio.scale_error");
+  r.range(vio.covariance_optimism, 0.1, 10.0, "vio.covariance_optimism");
   return r.message();
 }
 

@@ -23,6 +23,7 @@ using core::GpsTime;
 using core::kSpeedOfLightMps;
 
 constexpr std::uint64_t kOrbitStream = 0x0E7B, kClockStream = 0xC10C, kChannelStream = 0xC4A7;
+constexpr std::uint64_t kNlosLossStream = 0x2105;
 constexpr double kL1Hz = 1575.42e6;
 constexpr double kSkipBelowHorizonRad = -2.0 * core::kDegToRad;
 
@@ -161,6 +162,8 @@ struct Propagation {
 struct ChannelState {
   explicit ChannelState(Rng rng) : channel(rng) {}
   Channel channel;
+  int nlos_wall = -1;                ///< the wall whose NLOS loss is drawn below (-1: none yet)
+  double nlos_loss_spread_db = 0.0;  ///< that wall's loss about the mean (dB)
   bool has_last = false;
   double last_t_s = 0.0;
   double last_phase_extra_m = 0.0;
@@ -280,6 +283,21 @@ class ReceiverSimulator {
     return p;
   }
 
+  /// An NLOS signal's loss off `wall` (dB): the scenario's mean, plus the spread drawn once per satellite and wall
+  /// (the same for every band of the satellite), at least 0.
+  double nlos_loss_db(ChannelState& state, core::SatelliteId sat, int wall) const {
+    const ReflectionOptions& refl = setup_.scenario->reflections;
+    const double mean_db = refl.wall_loss_db + refl.nlos_extra_loss_db;
+    if (refl.nlos_loss_spread_db <= 0.0) return mean_db;
+    if (state.nlos_wall != wall) {
+      Rng rng = Rng::stream(setup_.seed, kNlosLossStream, static_cast<std::uint64_t>(sat.index()),
+                            static_cast<std::uint64_t>(wall));
+      state.nlos_wall = wall;
+      state.nlos_loss_spread_db = refl.nlos_loss_spread_db * rng.normal();
+    }
+    return std::max(0.0, mean_db + state.nlos_loss_spread_db);
+  }
+
   ChannelState& channel(core::SatelliteId sat, int signal_index) {
     const int key = sat.index() * 4 + signal_index;
     auto it = channels_.find(key);
@@ -348,7 +366,7 @@ class ReceiverSimulator {
       } else if (prop.nlos) {
         code_extra_m = prop.nlos->excess_m;
         phase_extra_m = prop.nlos->excess_m + 0.5 * lambda_m;
-        cn0 -= sc.reflections.wall_loss_db + sc.reflections.nlos_extra_loss_db;
+        cn0 -= nlos_loss_db(state, ctx.sat, prop.nlos->wall);
         path.receivable = above_cutoff;
         path.direct = false;
         path.wall = prop.nlos->wall;

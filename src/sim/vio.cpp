@@ -63,6 +63,8 @@ VioRun simulate_vio_along(const VioOptions& o, const core::GpsTime& start, doubl
   Pose previous_true;
   Matrix6d P = Matrix6d::Zero();
   P.diagonal() << Eigen::Vector3d::Constant(kInitialPositionVarM2), Eigen::Vector3d::Constant(kInitialAngleVarRad2);
+  // The covariance reported: the drift model's (P, linear in Q and P_0) over the optimism squared.
+  const double reported = 1.0 / (o.covariance_optimism * o.covariance_optimism);
   for (int k = 0;; ++k) {
     const double t_ns = first_ns + std::round(k * step_ns);
     const double t_s = true_seconds(o, t_ns);
@@ -78,17 +80,18 @@ VioRun simulate_vio_along(const VioOptions& o, const core::GpsTime& start, doubl
       const Matrix6d Q = step_noise(o, dT.p.norm());
       Vector6d n;
       for (int i = 0; i < 6; ++i) n(i) = std::sqrt(Q(i, i)) * rng.normal();
-      const Pose dT_estimate = dT * se3_exp(n);
+      const Pose dT_scaled{dT.q, (1.0 + o.scale_error) * dT.p};  // the VIO's scale error, unknown to its covariance
+      const Pose dT_estimate = dT_scaled * se3_exp(n);
       estimate = estimate * dT_estimate;
       // Propagated with the VIO's own (estimated) increment, as a VIO filter does: the reported covariances are then
       // consistent with the reported poses, which matters when a user differences absolute covariances of metres^2 to
       // get an increment's of millimetres^2 (A from the true increment differs by the increment's noise).
       const Matrix6d A = se3_adjoint(dT_estimate.inverse());
-      s.cross_previous = P * A.transpose();
+      s.cross_previous = P * A.transpose() * reported;
       P = A * P * A.transpose() + Q;
     }
     s.T_OI = estimate;
-    s.covariance = 0.5 * (P + P.transpose());
+    s.covariance = 0.5 * (P + P.transpose()) * reported;
     previous_true = s.T_OI_true;
     run.poses.push_back(s);
   }

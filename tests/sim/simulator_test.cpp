@@ -10,6 +10,7 @@
 
 #include "canyon/sim/simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -26,6 +27,7 @@
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
+#include "canyon/sim/signal_model.hpp"
 
 namespace canyon::sim {
 namespace {
@@ -368,6 +370,76 @@ TEST(SimulatorTest, NlosExactlyWhereTheCityBlocksTheDirectPath) {
   }
   EXPECT_GT(nlos, 200);
   EXPECT_GT(los, 200);
+}
+
+/// C/N0 of a 60 s urban-severe run with the given NLOS loss spread, for seeds 1-8: the NLOS signals' deficits below
+/// the line-of-sight model (dB), and the C/N0 of NLOS and of line-of-sight signals.
+struct Cn0Sample {
+  std::vector<double> nlos_deficit_db;
+  std::vector<double> nlos_dbhz;
+  std::vector<double> los_dbhz;
+};
+
+Cn0Sample cn0_sample(double spread_db) {
+  Cn0Sample out;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    Scenario s = shipped("urban-severe");
+    s.duration_s = 60.0;
+    s.seed = seed;
+    s.reflections.nlos_loss_spread_db = spread_db;
+    const auto g = generate(s, "nlos-spread", true);
+    for (const EpochTruth& e : g->sim.rover.truth) {
+      for (const SignalTruth& t : e.signals) {
+        if (t.direct) {
+          out.los_dbhz.push_back(t.cn0_dbhz);
+          continue;
+        }
+        const int band = t.code.band == '1' ? 0 : 1;
+        out.nlos_deficit_db.push_back(line_of_sight_cn0_dbhz(s.rover_receiver, t.elevation_rad, band) - t.cn0_dbhz);
+        out.nlos_dbhz.push_back(t.cn0_dbhz);
+      }
+    }
+  }
+  return out;
+}
+
+// With a loss spread, NLOS signals are not all the same dB down: some are as strong as line-of-sight ones (no C/N0
+// threshold separates them), as in real streets; without it every one is exactly wall + extra loss down.
+TEST(SimulatorTest, NlosLossSpreadOverlapsLineOfSightCn0) {
+  const Scenario defaults = shipped("urban-severe");
+  const double mean_db = defaults.reflections.wall_loss_db + defaults.reflections.nlos_extra_loss_db;
+  for (const double spread_db : {0.0, 6.0}) {
+    Cn0Sample c = cn0_sample(spread_db);
+    const std::vector<double>& d = c.nlos_deficit_db;
+    ASSERT_GT(d.size(), 2000U);
+    double sum = 0.0, sum2 = 0.0;
+    for (const double x : d) {
+      sum += x;
+      sum2 += x * x;
+    }
+    const double mean = sum / static_cast<double>(d.size());
+    const double sigma = std::sqrt(std::max(0.0, sum2 / static_cast<double>(d.size()) - mean * mean));
+    // The share of NLOS signals stronger than the weakest decile of line-of-sight ones: what a C/N0 screen set to
+    // keep 90 % of the line of sight lets through.
+    std::sort(c.los_dbhz.begin(), c.los_dbhz.end());
+    const double los_p10 = c.los_dbhz[c.los_dbhz.size() / 10];
+    const auto through = std::count_if(c.nlos_dbhz.begin(), c.nlos_dbhz.end(), [&](double x) { return x > los_p10; });
+    const double share = static_cast<double>(through) / static_cast<double>(d.size());
+    std::printf(
+        "NLOS loss spread %.0f dB: %zu NLOS signal epochs, deficit %.2f +- %.2f dB; %.1f %% stronger than the "
+        "weakest 10 %% of line of sight (%.1f dB-Hz)\n",
+        spread_db, d.size(), mean, sigma, 100.0 * share, los_p10);
+    if (spread_db == 0.0) {
+      EXPECT_NEAR(mean, mean_db, 1e-9);
+      EXPECT_LT(sigma, 1e-6);
+      EXPECT_EQ(through, 0);
+    } else {
+      EXPECT_NEAR(mean, mean_db, 3.0);  // the weakest fall below tracking: the mean seen is lower
+      EXPECT_GT(sigma, 4.0);
+      EXPECT_LT(sigma, 7.0);
+      EXPECT_GT(share, 0.03);
+    }
+  }
 }
 
 /// For each receiver file: every signal that comes back after missing from at least one epoch has LLI bit 0 set.

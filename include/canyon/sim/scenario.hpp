@@ -102,8 +102,13 @@ struct ReflectionOptions {
   /// A signal whose direct path a building blocks is received by a wall reflection (NLOS) when one exists; false: not
   /// at all, as by an ideal antenna and receiver that reject every reflection (the bound of perfect NLOS exclusion).
   bool nlos = true;
-  double wall_loss_db = 10.0;         ///< power of a wall reflection below the direct signal (dB)
-  double nlos_extra_loss_db = 2.0;    ///< extra loss of a reflection received without the direct signal (dB)
+  double wall_loss_db = 10.0;       ///< power of a wall reflection below the direct signal (dB)
+  double nlos_extra_loss_db = 2.0;  ///< extra loss of a reflection received without the direct signal (dB)
+  /// Spread (1 sigma) of an NLOS signal's loss about wall_loss_db + nlos_extra_loss_db (dB), drawn once per satellite
+  /// and wall (surfaces differ: glass, concrete, angles), at least 0 dB: with a spread of several dB the C/N0 of NLOS
+  /// signals overlaps that of line-of-sight ones, as in real streets, and no C/N0 threshold separates them. 0: every
+  /// NLOS signal is exactly that loss down (a C/N0 screen is then perfect, as nowhere real).
+  double nlos_loss_spread_db = 0.0;
   double ground_loss_db = 35.0;       ///< power of the ground reflection below the direct signal (dB)
   double max_wall_distance_m = 40.0;  ///< walls further from the antenna are not considered (m)
 };
@@ -160,6 +165,12 @@ struct VioOptions {
   double device_clock_offset_s = 1234.5;    ///< device clock reading at the scenario start (s)
   double device_clock_drift_ppm = 20.0;     ///< device clock rate error (1e-6)
   double timesync_jitter_s = 0.0005;        ///< noise of the built-in GPS time-sync pairs, 1 sigma (s)
+  /// Scale error of the VIO's translation: every increment is (1 + scale_error) times the true one (real VIO:
+  /// 0.2-1 %). Not in the reported covariance, as a real VIO does not know its scale error.
+  double scale_error = 0.0;
+  /// The reported covariance is the drift model's divided by this factor squared: >1 is over-confident (real VIO
+  /// reports sigmas 2-3 times too small); 1: the covariance describes the drift exactly.
+  double covariance_optimism = 1.0;
 };
 
 struct Scenario {

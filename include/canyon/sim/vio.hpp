@@ -29,6 +29,10 @@
 // with Ad(T) = [[R, [t]x R], [0, R]] for the [translation; rotation] ordering; P_0 = diag(1e-8 m^2 x 3,
 // 1e-10 rad^2 x 3) (O is defined by the first pose).
 //
+// Real VIO's errors the drift model leaves out, as options (both off by default): a scale error (every increment's
+// translation (1 + scale_error) times the true one, not in the covariance) and over-confidence (the reported
+// covariance is the one above over covariance_optimism^2).
+//
 // Clocks: the device clock reads t_ns = (device_clock_offset_s + (t - start)(1 + drift_ppm 1e-6)) 1e9 at GPST t.
 // Poses are at every 1 / rate_hz of device time; time-sync pairs at every whole GPST second, their device time with
 // Gaussian jitter.
