@@ -134,6 +134,9 @@ Table<F> time_bridge_and_vio_keys() {
        at(&F::vio, &V::reset_covariance_ratio)},
       {"vio_cross_covariance", "", "use the consecutive-pose cross-covariances (false: taken as zero)",
        at(&F::vio, &V::use_cross_covariance)},
+      {"vio_interpolation_accel_mps2", "m/s^2",
+       "acceleration the interpolation between poses misses (1 sigma): position sigma q x (1 - x) dt^2 / 2",
+       at(&F::vio, &V::interpolation_accel_mps2)},
   };
 }
 

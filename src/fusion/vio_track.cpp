@@ -24,6 +24,7 @@ std::string VioTrackOptions::validate() const {
     return "reset_covariance_ratio must be in [0, 1)";
   }
   if (!(extrapolation_s >= 0.0)) return "extrapolation_s must be >= 0";
+  if (!(interpolation_accel_mps2 >= 0.0)) return "interpolation_accel_mps2 must be >= 0";
   return {};
 }
 
@@ -242,7 +243,19 @@ Matrix12d VioTrack::joint_covariance(const VioPoseAt& a, const VioPoseAt& b) con
           J[static_cast<std::size_t>(v)]->transpose();
     }
   }
+  out.topLeftCorner<3, 3>().diagonal().array() += interpolation_variance_m2(a);
+  out.block<3, 3>(6, 6).diagonal().array() += interpolation_variance_m2(b);
   return 0.5 * (out + out.transpose());
+}
+
+double VioTrack::interpolation_variance_m2(const VioPoseAt& p) const {
+  if (!(options_.interpolation_accel_mps2 > 0.0)) return 0.0;
+  const int upper = p.lower + 1;
+  if (p.lower < forgotten_ || upper - forgotten_ >= static_cast<int>(samples_.size())) return 0.0;
+  const double dt_s = sample(upper).t_s - sample(p.lower).t_s;
+  const double x = std::clamp(p.a, 0.0, 1.0);
+  const double sigma_m = options_.interpolation_accel_mps2 * x * (1.0 - x) * dt_s * dt_s / 2.0;
+  return sigma_m * sigma_m;
 }
 
 core::Matrix6d VioTrack::covariance(const VioPoseAt& a) const {

@@ -163,6 +163,34 @@ TEST(VioTrackTest, GapsAreJudgedAgainstTheStreamsOwnRate) {
   EXPECT_EQ(slowed.samples()[99].segment, slowed.samples()[80].segment);
 }
 
+// Between two poses dt apart the interpolation misses the motion's acceleration: a pose at fraction x gets a position
+// sigma of q x (1 - x) dt^2 / 2 per axis, largest at the midpoint (q dt^2 / 8), none at a sample.
+TEST(VioTrackTest, InterpolatedPosesCarryTheInterpolationError) {
+  const core::GpsTime ref{2266, 100.0};
+  VioTrackOptions exact;
+  exact.interpolation_accel_mps2 = 0.0;
+  const VioTrackOptions honest;  // q = 1 m/s^2
+  for (const double dt_s : {1.0, 0.1}) {
+    const std::vector<VioTrackSample> s = straight_samples(20, dt_s, 1.4);
+    const VioTrack with = VioTrack::from_samples(s, ref, honest);
+    const VioTrack without = VioTrack::from_samples(s, ref, exact);
+    const auto mid_with = with.pose_at(ref + 5.5 * dt_s);
+    const auto mid_without = without.pose_at(ref + 5.5 * dt_s);
+    ASSERT_TRUE(mid_with && mid_without);
+    const double expected_m = honest.interpolation_accel_mps2 * dt_s * dt_s / 8.0;
+    const core::Matrix6d added = with.covariance(*mid_with) - without.covariance(*mid_without);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(added(i, i), expected_m * expected_m, 1e-15) << dt_s;
+    const double attitude_added = added.bottomRightCorner<3, 3>().norm();
+    EXPECT_NEAR(attitude_added, 0.0, 1e-15);  // the attitude is not touched
+    const auto at_sample = with.pose_at(ref + 5.0 * dt_s);
+    const auto at_sample_exact = without.pose_at(ref + 5.0 * dt_s);
+    EXPECT_NEAR((with.covariance(*at_sample) - without.covariance(*at_sample_exact)).norm(), 0.0, 1e-15);
+  }
+  VioTrackOptions negative;
+  negative.interpolation_accel_mps2 = -1.0;
+  EXPECT_NE(negative.validate().find("interpolation_accel_mps2"), std::string::npos);
+}
+
 TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   std::vector<VioTrackSample> s = straight_samples(40, 0.1, 1.4);
   for (int k = 10; k < 40; ++k) s[static_cast<std::size_t>(k)].t_s += 1.0;           // a 1.1 s gap before sample 10
