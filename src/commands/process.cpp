@@ -313,8 +313,9 @@ void report_vio_segments(const fusion::VioTrack& track, const fusion::VioTrackOp
                   fusion::kGapIntervals, track.segments());
     summary.report.emplace_back(line);
   }
-  for (std::size_t i = 0; i < notes.size() && i < kMaxSegmentNotes; ++i)
+  for (std::size_t i = 0; i < notes.size() && i < kMaxSegmentNotes; ++i) {
     summary.report.push_back("fusion: " + notes[i]);
+  }
   if (notes.size() <= kMaxSegmentNotes) return;
   int gaps = 0;
   int jumps = 0;

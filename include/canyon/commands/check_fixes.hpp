@@ -3,6 +3,7 @@
 // input as configured, then again with the 1, 2, ... N most-observed satellites left out, and compares each left-out
 // solution's fixes with the full solution's at the epochs fixed in both.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,7 @@ struct CheckFixesResult {
 [[nodiscard]] std::string leave_out_path(const std::string& out, int left_out);
 
 /// Runs the check (config.mode rtk or fusion; config.out is the full solution's file, the others beside it).
-/// `progress` is called per run with the run's label ("full", "leave out 1", ...).
+/// `progress` is called before each run with its label ("full solution", "leave out 1", ...).
 Result<CheckFixesResult> check_fixes(const config::ProcessConfig& config, const CheckFixesOptions& options,
                                      const std::function<void(const std::string&)>& progress = {});
 
