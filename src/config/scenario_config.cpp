@@ -237,6 +237,8 @@ const Table<sim::CityOptions>& city_table() {
       {"height_max_m", "m", "tallest building, >= height_min_m", at(&C::height_max_m)},
       {"gap_probability", "", "probability that a lot is empty (plaza, parking), 0..1", at(&C::gap_probability)},
       {"margin_m", "m", "buildings at least this far around the route", at(&C::margin_m)},
+      {"start_square_m", "m", "side of an open square at the origin, where a generated walk starts; 0: none",
+       at(&C::start_square_m)},
       {"blocks", "", "[nx, ny]: a city of nx by ny blocks centred on the origin; []: sized to the route",
        at(&C::blocks), Blocks{}},
   };

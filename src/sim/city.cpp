@@ -339,6 +339,13 @@ City generate_city(const CityOptions& city, const TreeOptions& trees, const City
     }
     buildings.push_back(std::move(b));
   };
+  // A lot overlapping the open square at the origin stays empty (its random draws are made all the same, so that the
+  // rest of the city does not change with the square).
+  const double square_half_m = city.start_square_m / 2.0;
+  const auto in_start_square = [square_half_m](double x_lo, double y_lo, double x_hi, double y_hi) {
+    return square_half_m > 0.0 && x_lo < square_half_m && x_hi > -square_half_m && y_lo < square_half_m &&
+           y_hi > -square_half_m;
+  };
   if (city.buildings) {
     for (int j = j0; j < j1; ++j) {
       for (int i = i0; i < i1; ++i) {
@@ -352,7 +359,9 @@ City generate_city(const CityOptions& city, const TreeOptions& trees, const City
             const bool gap = rng.bernoulli(city.gap_probability);
             const double height =
                 std::clamp(rng.normal(city.height_mean_m, city.height_sigma_m), city.height_min_m, city.height_max_m);
-            if (!gap && height > 0.0) add_rect(x, row_lo, x + width, row_hi, height);
+            if (!gap && height > 0.0 && !in_start_square(x, row_lo, x + width, row_hi)) {
+              add_rect(x, row_lo, x + width, row_hi, height);
+            }
             x += width;
           }
         }

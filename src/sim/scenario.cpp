@@ -56,6 +56,7 @@ void check_city(const CityOptions& c, Rules& r) {
   r.non_negative(c.height_sigma_m, "city.height_sigma_m");
   r.range(c.gap_probability, 0.0, 1.0, "city.gap_probability");
   r.non_negative(c.margin_m, "city.margin_m");
+  r.non_negative(c.start_square_m, "city.start_square_m");
   r.require(c.blocks.empty() || c.blocks.size() == 2, "city.blocks", "must be [nx, ny]",
             static_cast<double>(c.blocks.size()));
   for (const int n : c.blocks) r.require(n >= 1 && n <= 1000, "city.blocks", "must be between 1 and 1000", n);

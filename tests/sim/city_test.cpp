@@ -2,6 +2,7 @@
 
 #include "canyon/sim/city.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -123,6 +124,36 @@ TEST(CityTest, GeneratedCityRespectsItsParameters) {
   for (int i = -3; i <= 3; ++i) {
     EXPECT_FALSE(city.inside_building(grid.to_N({i * grid.pitch_x_m, 17.0})));
     EXPECT_FALSE(city.inside_building(grid.to_N({13.0, i * grid.pitch_y_m})));
+  }
+}
+
+// An open square at the origin, where a generated walk starts: no building overlaps it, and every other building is
+// the one the city without the square has (the square does not reshuffle the city).
+TEST(CityTest, StartSquareIsOpenAndTheRestOfTheCityUnchanged) {
+  CityOptions options;
+  options.grid_azimuth_deg = 30.0;
+  const StreetGrid grid = StreetGrid::from(options);
+  const CityExtent extent = blocks_extent({6, 6}, grid);
+  const City closed = generate_city(options, TreeOptions{}, extent, 9);
+  options.start_square_m = 120.0;
+  const City open = generate_city(options, TreeOptions{}, extent, 9);
+  ASSERT_LT(open.buildings().size(), closed.buildings().size());
+  for (const Building& b : open.buildings()) {
+    Eigen::Vector2d lo_G = grid.to_G(b.footprint_N_m.front()), hi_G = lo_G;
+    for (const Eigen::Vector2d& c : b.footprint_N_m) {
+      lo_G = lo_G.cwiseMin(grid.to_G(c));
+      hi_G = hi_G.cwiseMax(grid.to_G(c));
+    }
+    const bool overlaps = lo_G.x() < 60.0 && hi_G.x() > -60.0 && lo_G.y() < 60.0 && hi_G.y() > -60.0;
+    EXPECT_FALSE(overlaps) << "a building overlaps the start square at " << lo_G.transpose();
+    const bool also_in_closed =
+        std::any_of(closed.buildings().begin(), closed.buildings().end(), [&](const Building& c) {
+          return c.height_m == b.height_m && (c.footprint_N_m.front() - b.footprint_N_m.front()).norm() < 1e-9;
+        });
+    EXPECT_TRUE(also_in_closed);
+  }
+  for (const double x : {-50.0, 0.0, 50.0}) {
+    for (const double y : {-50.0, 0.0, 50.0}) EXPECT_FALSE(open.inside_building(grid.to_N({x, y})));
   }
 }
 

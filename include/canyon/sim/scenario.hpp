@@ -35,7 +35,10 @@ struct CityOptions {
   double height_max_m = 81.0;     ///< tallest building (m)
   double gap_probability = 0.05;  ///< probability that a lot is empty (plaza, parking, side alley)
   double margin_m = 300.0;        ///< buildings extend at least this far beyond the route (m)
-  std::vector<int> blocks;        ///< optional [nx, ny]: city of nx by ny blocks centred on the origin
+  /// Side of an open square centred on the origin, where a generated walk starts (a user starts a session in the
+  /// open): no building overlaps it (m); 0: none.
+  double start_square_m = 0.0;
+  std::vector<int> blocks;  ///< optional [nx, ny]: city of nx by ny blocks centred on the origin
 };
 
 /// Street trees (light-blocked scenario): crowns as vertical cylinders along the kerbs.
