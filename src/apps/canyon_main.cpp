@@ -428,9 +428,11 @@ int run_simulate_command(const SimulateArgs& args) {
   if (!args.quiet) {
     std::fprintf(stderr,
                  "canyon simulate: %s seed %llu: %d rover epochs, %d base epochs, %d rover signals (%.1f %% NLOS), "
+                 "line-of-sight ceiling %.1f %% (epochs with >= 5 satellites tracking phase in line of sight), "
                  "%d lock losses, %d slips, %d buildings, route %.0f m, %.2f s wall, files in %s\n",
                  scenario->name.c_str(), static_cast<unsigned long long>(scenario->seed), summary->rover_epochs,
                  summary->base_epochs, summary->rover_signal_epochs, 100.0 * summary->nlos_fraction,
+                 summary->rover_epochs > 0 ? 100.0 * summary->line_of_sight_epochs / summary->rover_epochs : 0.0,
                  summary->rover_losses, summary->rover_slips, summary->buildings, summary->route_length_m,
                  summary->wall_s, args.out.c_str());
   }

@@ -62,6 +62,7 @@ std::string truth_section(const sim::Simulation& sim) {
   line("trees", std::to_string(sim.city.trees().size()));
   line("rover_signal_epochs", std::to_string(sim.rover.signal_epochs));
   line("rover_nlos_signal_epochs", std::to_string(sim.rover.nlos_signal_epochs));
+  line("rover_line_of_sight_epochs", std::to_string(sim.rover.line_of_sight_epochs));  // >= 5 LOS phase satellites
   line("rover_lock_losses", std::to_string(sim.rover.losses));
   line("rover_slips", std::to_string(sim.rover.slips));
   // VIO: the lever arm, the odometry frame (gravity-aligned, origin at the IMU's start, see sim/vio.hpp), the device
@@ -105,6 +106,7 @@ Result<SimulateSummary> run_simulate(const sim::Scenario& scenario, const std::s
   summary.rover_signal_epochs = sim->rover.signal_epochs;
   summary.nlos_fraction =
       sim->rover.signal_epochs > 0 ? double(sim->rover.nlos_signal_epochs) / sim->rover.signal_epochs : 0.0;
+  summary.line_of_sight_epochs = sim->rover.line_of_sight_epochs;
   summary.rover_losses = sim->rover.losses;
   summary.rover_slips = sim->rover.slips;
   summary.buildings = static_cast<int>(sim->city.buildings().size());

@@ -229,19 +229,25 @@ class ReceiverSimulator {
     truth.t_s = t_s;
     truth.p_E_m = p_E;
     truth.p_N_m = p_N;
+    int line_of_sight = 0;  // satellites output with phase on the direct path
     for (const core::SatelliteId sat : sats_) {
       const auto view = satellites_.view(sat, t_rx, p_E, up_E);
       core::SatelliteObs obs;
       obs.sat = sat;
+      bool direct = false;
       if (view) {
         Context ctx{sat, *view, t_s, dt_r, p_N, v_E, rcv, R_NE_local, walls};
         ctx.propagation = propagate(ctx);
         observe(ctx, obs, truth, out);
+        direct = ctx.propagation.direct;
       } else {
         step_unseen(sat, t_s);
       }
-      if (!obs.signals.empty()) epoch.sats.push_back(std::move(obs));
+      if (obs.signals.empty()) continue;
+      if (direct) ++line_of_sight;
+      epoch.sats.push_back(std::move(obs));
     }
+    if (line_of_sight >= kLineOfSightCeilingSatellites) ++out.line_of_sight_epochs;
     if (setup_.keep_truth) out.truth.push_back(std::move(truth));
     return epoch;
   }

@@ -30,8 +30,10 @@ struct SimulateSummary {
   int base_epochs = 0;
   int rover_signal_epochs = 0;  ///< signals in the rover file, summed over epochs
   double nlos_fraction = 0.0;   ///< of rover signals received only by reflection
-  int rover_losses = 0;         ///< rover lock losses (followed by a reacquisition with LLI, if the signal returns)
-  int rover_slips = 0;          ///< rover cycle slips while locked (LLI set)
+  /// Rover epochs with >= 5 satellites tracking phase in line of sight (the line-of-sight ceiling of a correct fix).
+  int line_of_sight_epochs = 0;
+  int rover_losses = 0;  ///< rover lock losses (followed by a reacquisition with LLI, if the signal returns)
+  int rover_slips = 0;   ///< rover cycle slips while locked (LLI set)
   int buildings = 0;
   double route_length_m = 0.0;
   double wall_s = 0.0;

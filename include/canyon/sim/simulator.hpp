@@ -67,6 +67,9 @@ struct EpochTruth {
   std::vector<SignalTruth> signals;
 };
 
+/// Satellites tracking phase in line of sight that an epoch needs to count under the line-of-sight ceiling.
+inline constexpr int kLineOfSightCeilingSatellites = 5;
+
 struct ReceiverRun {
   io::RinexObsHeader header;
   std::vector<core::ObsEpoch> epochs;
@@ -75,8 +78,11 @@ struct ReceiverRun {
   double clock_drift_sps = 0.0;   ///< initial receiver clock drift
   int signal_epochs = 0;          ///< signals output, summed over epochs
   int nlos_signal_epochs = 0;     ///< of which received only by reflection
-  int losses = 0;                 ///< lock losses
-  int slips = 0;                  ///< slips while locked
+  /// Epochs with at least kLineOfSightCeilingSatellites satellites tracking phase on the direct path: the ceiling of
+  /// what any RTK can fix correctly (the rest has too few clean double differences).
+  int line_of_sight_epochs = 0;
+  int losses = 0;  ///< lock losses
+  int slips = 0;   ///< slips while locked
 };
 
 /// Rover antenna truth at a rover epoch tag (GPST), with the body attitude R_EI (I: x forward, y left, z up).
