@@ -68,7 +68,7 @@ best=""
 printf '\nset-up        median correct %%   fixed   correct   wrong   correct share of fixes\n'
 for s in "${setups[@]}"; do
   med=$(tr ' ' '\n' <<<"${rates[$s]:-}" | grep -v '^$' | median)
-  share=$(awk -v c="${correct_sum[$s]:-0}" -v f="${fixed_sum[$s]:-0}" 'BEGIN {printf "%.1f", f > 0 ? 100 * c / f : 0}')
+  share=$(awk -v c="${correct_sum[$s]:-0}" -v f="${fixed_sum[$s]:-0}" 'BEGIN {printf "%.1f", (f > 0 ? 100 * c / f : 0)}')
   printf '%-13s %16s %7s %9s %7s %10s %%\n' "$s" "$med" "${fixed_sum[$s]:-0}" "${correct_sum[$s]:-0}" \
     "${wrong_sum[$s]:-0}" "$share"
   if [[ -z $best || ${correct_sum[$s]:-0} -gt ${correct_sum[$best]:-0} ]]; then best=$s; fi
