@@ -75,7 +75,7 @@ TEST(DemoCli, FailingRtklibIsAnErrorThatPointsToItsLog) {
 }
 
 TEST(DemoCli, UnknownScenarioIsAUsageErrorAndUnwritableFolderAnInputError) {
-  const auto unknown = canyon("demo --scenario downtown --out /tmp/canyon-demo-unused");
+  const auto unknown = canyon("demo --scenario midtown --out /tmp/canyon-demo-unused");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
   EXPECT_NE(unknown.output.find("urban-severe"), std::string::npos) << unknown.output;
   const auto unwritable = canyon("demo --duration 10 --out /proc/canyon-demo");

@@ -56,7 +56,7 @@ fs::path run_rtklib(const fs::path& dir) {
 }
 
 TEST(SimulateCli, UnknownScenarioAndBadFileAreUsageErrors) {
-  const auto unknown = canyon("simulate --scenario downtown --out /tmp/x");
+  const auto unknown = canyon("simulate --scenario midtown --out /tmp/x");
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.output.find("urban-severe"), std::string::npos) << unknown.output;
   const fs::path bad = test::temp_dir("simulate") / "bad.yaml";
