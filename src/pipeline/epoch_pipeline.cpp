@@ -41,6 +41,14 @@ EpochOutput output_of(Epoch& epoch, const rtk::RtkEpoch& filter) {
   return out;
 }
 
+/// A failed prediction is the solved epoch's output (its error); true when it failed, and nothing is left to resolve.
+bool prediction_failed(SolvedEpoch& solved) {
+  const Result<bool>& verdict = solved.updated.predicted.verdict;
+  if (verdict) return false;
+  solved.output = verdict.error();
+  return true;
+}
+
 /// The prediction's verdict: go on to the update.
 bool goes_on(const PredictedEpoch& epoch) {
   return epoch.verdict && *epoch.verdict;
@@ -86,11 +94,7 @@ UpdatedEpoch RtkEstimator::update(PredictedEpoch epoch) {
 
 SolvedEpoch RtkEstimator::resolve(UpdatedEpoch epoch) {
   SolvedEpoch solved{std::move(epoch)};
-  const Result<bool>& verdict = solved.updated.predicted.verdict;
-  if (!verdict) {
-    solved.output = verdict.error();
-    return solved;
-  }
+  if (prediction_failed(solved)) return solved;
   if (solved.updated.to_resolve) engine_.resolve();
   rtk::RtkEpoch result = engine_.take_epoch();
   solved.output = output_of(result, result);
@@ -124,11 +128,7 @@ UpdatedEpoch FusionEstimator::update(PredictedEpoch epoch) {
 
 SolvedEpoch FusionEstimator::resolve(UpdatedEpoch epoch) {
   SolvedEpoch solved{std::move(epoch)};
-  const Result<bool>& verdict = solved.updated.predicted.verdict;
-  if (!verdict) {
-    solved.output = verdict.error();
-    return solved;
-  }
+  if (prediction_failed(solved)) return solved;
   if (solved.updated.to_resolve) engine_.resolve();
   fusion::FusionEpoch result = engine_.finish_epoch();
   EpochOutput out = output_of(result, result.rtk);

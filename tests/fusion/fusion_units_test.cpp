@@ -122,6 +122,23 @@ std::vector<VioTrackSample> straight_samples(int n, double dt_s, double speed_mp
   return s;
 }
 
+/// The samples appended one by one to a streaming track (each append must succeed), the segment notes in `notes`.
+VioTrack streamed(const std::vector<VioTrackSample>& samples, const core::GpsTime& ref,
+                  std::vector<std::string>& notes) {
+  VioTrack live = VioTrack::streaming({});
+  for (const VioTrackSample& v : samples) {
+    io::VioRecord r;
+    r.T_OI = v.T_OI;
+    r.covariance = v.P;
+    r.cross_previous = v.C_previous;
+    r.line = v.line;
+    std::string note;
+    EXPECT_TRUE(live.append(r, ref + v.t_s, &note)) << "sample at " << v.t_s << " s";
+    if (!note.empty()) notes.push_back(note);
+  }
+  return live;
+}
+
 // A VIO stream is used at its own rate: 1 Hz and 2 Hz poses are one segment, a gap is judged against their interval,
 // a 10 Hz stream keeps vio_max_gap_s; streaming gives the same segments as the whole file.
 TEST(VioTrackTest, GapsAreJudgedAgainstTheStreamsOwnRate) {
@@ -134,16 +151,8 @@ TEST(VioTrackTest, GapsAreJudgedAgainstTheStreamsOwnRate) {
     const VioTrack whole = VioTrack::from_samples(s, ref);
     EXPECT_EQ(whole.segments(), 2) << dt_s;
     EXPECT_EQ(whole.samples()[30].segment, 1);
-    VioTrack live = VioTrack::streaming({});
     std::vector<std::string> notes;
-    for (const VioTrackSample& v : s) {
-      io::VioRecord r;
-      r.T_OI = v.T_OI;
-      r.covariance = v.P;
-      std::string note;
-      ASSERT_TRUE(live.append(r, ref + v.t_s, &note));
-      if (!note.empty()) notes.push_back(note);
-    }
+    const VioTrack live = streamed(s, ref, notes);
     EXPECT_EQ(live.segments(), 2);
     ASSERT_EQ(notes.size(), 1U);
     EXPECT_NE(notes[0].find("VIO gap of"), std::string::npos) << notes[0];
@@ -265,18 +274,8 @@ TEST(VioTrackTest, AppendedPoseByPoseEqualsTheWholeTrackAndForgettingKeepsIndice
   for (int k = 1; k < 60; ++k) s[static_cast<std::size_t>(k)].C_previous = core::Matrix6d::Identity() * 1e-5;
   const core::GpsTime ref{2266, 100.0};
   const VioTrack whole = VioTrack::from_samples(s, ref);
-  VioTrack live = VioTrack::streaming({});
   std::vector<std::string> notes;
-  for (const VioTrackSample& v : s) {
-    io::VioRecord r;
-    r.T_OI = v.T_OI;
-    r.covariance = v.P;
-    r.cross_previous = v.C_previous;
-    r.line = v.line;
-    std::string note;
-    ASSERT_TRUE(live.append(r, ref + v.t_s, &note));
-    if (!note.empty()) notes.push_back(note);
-  }
+  VioTrack live = streamed(s, ref, notes);
   io::VioRecord again;
   EXPECT_FALSE(live.append(again, ref + s.back().t_s));  // not after the last pose
   EXPECT_EQ(live.segments(), whole.segments());
