@@ -3,6 +3,7 @@
 #include "canyon/fusion/fusion_engine.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "canyon/core/constants.hpp"
@@ -18,6 +19,7 @@ namespace {
 /// The RTK filter's options with the heading error state when the fusion estimates it.
 rtk::RtkOptions with_heading_state(rtk::RtkOptions rtk_options, const FusionOptions& options) {
   rtk_options.aiding_heading_state = options.heading.enabled && options.prediction.kind == Prediction::Vio;
+  rtk_options.aiding_scale_state = options.prediction.scale_state && options.prediction.kind == Prediction::Vio;
   return rtk_options;
 }
 
@@ -163,7 +165,17 @@ std::optional<MotionPrediction> FusionEngine::predict_from_vio(const std::option
   if (widen) ++stats_.widened;
   MotionPrediction prediction = predict_with_vio(in, options_.prediction, widen);  // Eqs. 3-6
   if (heading_state) couple_heading(motion, prediction.increment.dp_E_m, up_E, *alignment, options_.heading);
+  if (options_.prediction.scale_state) couple_scale(motion, prediction.increment.dp_E_m, pose->segment);
   return prediction;
+}
+
+void FusionEngine::couple_scale(rtk::ExternalMotion& motion, const Eigen::Vector3d& dp_E_m, int segment) {
+  const PredictionOptions& o = options_.prediction;
+  const double walk = o.vio_scale_random_walk_per_sqrt_km;
+  motion.scale_noise = walk * walk * dp_E_m.norm() / 1000.0;
+  motion.scale_variance = o.vio_scale_sigma * o.vio_scale_sigma;
+  motion.restart_scale = scale_segment_ != segment;  // a new odometry segment may have a scale of its own
+  scale_segment_ = segment;
 }
 
 FusionGeometryBuilder FusionEngine::make_geometry_builder() const {
@@ -266,6 +278,12 @@ void FusionEngine::after_output(const FusionEpoch& out) {
     if (const std::optional<double> psi = fold_heading_error(engine_, *alignment)) {
       stats_.heading_folded_rad += *psi;
       stats_.heading_sigma_rad = alignment->yaw_sigma_rad;
+    }
+  }
+  if (out.aided) {
+    if (const std::optional<rtk::RtkEngine::ScaleError> scale = engine_.scale_error()) {
+      stats_.scale_error = scale->s;
+      stats_.scale_sigma = std::sqrt(scale->variance);
     }
   }
   if (out.aided && out.solution.status != core::SolutionStatus::None) {

@@ -43,6 +43,11 @@ std::vector<std::string> FusionEngine::report() const {
                "heading sigma %.2f deg at the end",
                s.heading_folded_rad * core::kRadToDeg, s.heading_sigma_rad * core::kRadToDeg));
   }
+  if (options_.prediction.scale_state) {
+    lines.push_back(
+        format("fusion: scale state: the VIO's increments taken times 1 %+.3f %% (sigma %.3f %%) at the end",
+               100.0 * s.scale_error, 100.0 * s.scale_sigma));
+  }
   if (options_.integrity.enabled) {
     lines.push_back(
         format("fusion: integrity check: %.0f restarts from the single point (median offset over %.0f s "

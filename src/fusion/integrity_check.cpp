@@ -8,8 +8,9 @@
 namespace canyon::fusion {
 
 std::string IntegrityCheckOptions::validate() const {
-  if (!(window_s > 0.0) || min_points < 1 || !(max_offset_m > 0.0)) {
-    return "integrity_window_s and integrity_max_offset_m must be > 0 and integrity_min_points >= 1";
+  if (!(window_s > 0.0) || min_points < 1 || !(max_offset_m > 0.0) || !(min_agreeing_share > 0.0)) {
+    return "integrity_window_s, integrity_max_offset_m and integrity_min_agreeing_share must be > 0 and "
+           "integrity_min_points >= 1";
   }
   return {};
 }
@@ -30,6 +31,12 @@ std::optional<IntegrityRestart> IntegrityCheck::check(const core::GpsTime& t, co
   if (static_cast<int>(offsets_.size()) < options_.min_points) return std::nullopt;
   const Eigen::Vector2d median_m(median_offset_m(0), median_offset_m(1));
   if (median_m.norm() <= options_.max_offset_m) return std::nullopt;
+  // An output that a share of the single points still agrees with has not left them: in a deep canyon the single
+  // points split into a group near the output and a group hundreds of metres off (NLOS), and the median may fall in
+  // the latter.
+  int agreeing = 0;
+  for (const Offset& o : offsets_) agreeing += o.d_EN_m.norm() <= options_.max_offset_m ? 1 : 0;
+  if (agreeing >= options_.min_agreeing_share * static_cast<double>(offsets_.size())) return std::nullopt;
   // Horizontally the single points' median, with their spread about it as its variance; vertically the output's.
   Eigen::Vector2d spread2 = Eigen::Vector2d::Zero();
   for (const Offset& o : offsets_) spread2 += (o.d_EN_m - median_m).cwiseAbs2();

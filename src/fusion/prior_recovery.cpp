@@ -5,8 +5,8 @@
 namespace canyon::fusion {
 
 std::string PriorRecoveryOptions::validate() const {
-  if (max_prior_rejections < 0 || gate_conflict_epochs < 1 || !(reanchor_sigma_m > 0.0)) {
-    return "max_prior_rejections must be >= 0, gate_conflict_epochs >= 1 and reanchor_sigma_m > 0";
+  if (max_prior_rejections < 0 || gate_conflict_epochs < 0 || !(reanchor_sigma_m > 0.0)) {
+    return "max_prior_rejections must be >= 0, gate_conflict_epochs >= 0 and reanchor_sigma_m > 0";
   }
   return {};
 }
@@ -19,6 +19,7 @@ bool PriorRecovery::reanchor(bool prior_only) {
 }
 
 void PriorRecovery::count_gate_conflict(int rejected, int used) {
+  if (options_.gate_conflict_epochs == 0) return;  // never widened
   gate_conflicts_ = rejected > used ? gate_conflicts_ + 1 : 0;
   if (gate_conflicts_ >= options_.gate_conflict_epochs) {
     widen_next_ = true;

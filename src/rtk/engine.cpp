@@ -20,7 +20,7 @@ RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides
     : options_(std::move(options)),
       eph_(ephemerides),
       p_E_base_m_(std::move(p_E_base_m)),
-      state_(StateLayout{options_.dynamics, options_.aiding_heading_state}),
+      state_(StateLayout{options_.dynamics, options_.aiding_heading_state, options_.aiding_scale_state}),
       resolver_(options_),
       geometry_builder_(geometry_options(), eph_, p_E_base_m_) {}
 
@@ -114,11 +114,11 @@ void RtkEngine::predict_states(const core::ObsEpoch& rover, EpochGeometry& geome
   choose_ionosphere_model((sol.p_E_m - p_E_base_m_).norm());  // single-point position, or the prior
   const double dt_s = last_time_ ? std::abs(rover.time - *last_time_) : 0.0;
   if (motion != nullptr) {
-    external_motion_update(state_, *motion, heading_live_);
+    external_motion_update(state_, *motion, live_);
   } else {
     own_motion_update(state_, options_, dt_s, !initialised_, *geometry.spp);
     initialised_ = true;
-    heading_live_ = false;  // an epoch without external motion: the next one with it restarts the heading error
+    live_ = {};  // an epoch without external motion: the next one with it restarts the aiding error states
   }
   keyed_random_walk(state_, options_, dt_s);
   last_time_ = rover.time;
@@ -268,9 +268,15 @@ void RtkEngine::revert_to_prior() {
 }
 
 std::optional<RtkEngine::HeadingError> RtkEngine::heading_error() const {
-  if (state_.heading_index() < 0 || !heading_live_) return std::nullopt;
+  if (state_.heading_index() < 0 || !live_.heading) return std::nullopt;
   const int h = state_.heading_index();
   return HeadingError{state_.x()[h], state_.P()(h, h)};
+}
+
+std::optional<RtkEngine::ScaleError> RtkEngine::scale_error() const {
+  if (state_.scale_index() < 0 || !live_.scale) return std::nullopt;
+  const int i = state_.scale_index();
+  return ScaleError{state_.x()[i], state_.P()(i, i)};
 }
 
 std::optional<RtkEngine::HeadingError> RtkEngine::take_heading_error() {

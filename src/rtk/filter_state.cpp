@@ -114,23 +114,21 @@ void FilterState::add_keyed_random_walk(double q_ambiguity, double q_ionosphere)
   }
 }
 
-void FilterState::restart_heading(double variance_rad2) {
-  const int h = heading_index();
-  assert(h >= 0);
-  x_[h] = 0.0;
-  P_.row(h).setZero();
-  P_.col(h).setZero();
-  P_(h, h) = variance_rad2;
+void FilterState::restart_aiding_state(int index, double variance) {
+  assert(index >= 0 && index < num_unkeyed());
+  x_[index] = 0.0;
+  P_.row(index).setZero();
+  P_.col(index).setZero();
+  P_(index, index) = variance;
 }
 
-void FilterState::couple_heading(const Eigen::Vector3d& J, double noise_rad2) {
-  const int h = heading_index();
-  assert(h >= 0);
-  // F = I + J e_h^T: F P gives the position rows J times row h, then (F P) F^T the position columns column h J^T.
-  x_.head<3>() += J * x_[h];
-  P_.topRows<3>() += J * P_.row(h);
-  P_.leftCols<3>() += P_.col(h) * J.transpose();
-  P_(h, h) += noise_rad2;
+void FilterState::couple_aiding_state(int index, const Eigen::Vector3d& J, double noise) {
+  assert(index >= 0 && index < num_unkeyed());
+  // F = I + J e_i^T: F P gives the position rows J times row i, then (F P) F^T the position columns column i J^T.
+  x_.head<3>() += J * x_[index];
+  P_.topRows<3>() += J * P_.row(index);
+  P_.leftCols<3>() += P_.col(index) * J.transpose();
+  P_(index, index) += noise;
 }
 
 void FilterState::set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2) {

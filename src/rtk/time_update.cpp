@@ -29,14 +29,22 @@ void own_motion_update(FilterState& state, const RtkOptions& options, double dt_
   state.add_acceleration_noise(R_EN, Q_N);
 }
 
-void external_motion_update(FilterState& state, const ExternalMotion& motion, bool& heading_live) {
+void external_motion_update(FilterState& state, const ExternalMotion& motion, AidingLive& live) {
   state.add_position_increment(motion.delta_p_E_m, motion.Q_E_m2);
-  if (state.heading_index() < 0) return;
-  if (motion.restart_heading || !heading_live) {
-    state.restart_heading(motion.heading_variance_rad2);
-    heading_live = true;
+  if (state.heading_index() >= 0) {
+    if (motion.restart_heading || !live.heading) {
+      state.restart_heading(motion.heading_variance_rad2);
+      live.heading = true;
+    }
+    state.couple_heading(motion.dp_d_heading_E_m, motion.heading_noise_rad2);
   }
-  state.couple_heading(motion.dp_d_heading_E_m, motion.heading_noise_rad2);
+  if (state.scale_index() >= 0) {
+    if (motion.restart_scale || !live.scale) {
+      state.restart_scale(motion.scale_variance);
+      live.scale = true;
+    }
+    state.couple_scale(motion.delta_p_E_m, motion.scale_noise);
+  }
 }
 
 void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_s) {

@@ -38,7 +38,9 @@ TEST(FusionPieces, PredictWithVioIsEqsThreeToSix) {
   in.joint = Matrix12d::Identity() * 1e-6;
   in.t_IA_m = Eigen::Vector3d(0.1, 0.0, 0.05);
   in.R_EO = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, 0.3, 0.9).normalized()).toRotationMatrix();
-  const MotionPrediction p = predict_with_vio(in, PredictionOptions{});
+  PredictionOptions paper;
+  paper.vio_sigma_factor = 1.0;  // the VIO's covariance as reported
+  const MotionPrediction p = predict_with_vio(in, paper);
   const Eigen::Vector3d dp_O = in.T_OI_next.q * in.t_IA_m + in.T_OI_next.p - (in.T_OI_i.q * in.t_IA_m + in.T_OI_i.p);
   EXPECT_LT((p.increment.dp_O_m - dp_O).norm(), 1e-12);                            // the antenna's increment
   EXPECT_LT((p.dp_E_m - in.R_EO * dp_O).norm(), 1e-12);                            // Eq. 5
@@ -48,6 +50,12 @@ TEST(FusionPieces, PredictWithVioIsEqsThreeToSix) {
   // Eq. 4 with the joint covariance sigma^2 I: J J^T sigma^2, J = [-R_i (.. ) | R_i+1 (..)]: at least both
   // positions' 2 sigma^2 on the diagonal.
   EXPECT_GE(p.increment.cov_O_m2.diagonal().minCoeff(), 2e-6 - 1e-15);
+  // Beyond the paper: an over-confident VIO's covariance taken times vio_sigma_factor^2.
+  PredictionOptions inflated;
+  inflated.vio_sigma_factor = 2.0;
+  const MotionPrediction r = predict_with_vio(in, inflated);
+  EXPECT_LT((r.Q_E_m2 - 4.0 * p.increment.cov_E_m2).norm(), 1e-15);
+  EXPECT_LT((r.prior.P_E_m2 - (in.P_E_m2 + 4.0 * p.increment.cov_E_m2)).norm(), 1e-15);
   // The ablation's constant covariance and the recovery's widening.
   PredictionOptions constant;
   constant.vio_covariance = false;
@@ -211,6 +219,19 @@ TEST(FusionPieces, TheIntegrityCheckRestartsWhenTheMedianSinglePointIsFarOff) {
     EXPECT_FALSE(
         quiet.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, kP0 + R_EN * Eigen::Vector3d(3, 0, 0)));
     EXPECT_FALSE(quiet.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, std::nullopt));
+  }
+  // A split group (downtown): 3 in 10 single points near the output, the rest 200 m off. The median is far, but the
+  // output still agrees with min_agreeing_share (0.2) of them: no restart. With 1 in 10 near it restarts.
+  for (const int near_every : {3, 10}) {
+    IntegrityCheck split(options);
+    std::optional<IntegrityRestart> moved;
+    for (int k = 0; k < 30; ++k) {
+      const bool near = k % 10 < (near_every == 3 ? 3 : 1);
+      const Eigen::Vector3d spp = kP0 + R_EN * (near ? Eigen::Vector3d(5.0, 0.0, 0.0) : Eigen::Vector3d(0.0, 200.0, 0));
+      moved = split.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, spp);
+      if (moved) break;
+    }
+    EXPECT_EQ(moved.has_value(), near_every == 10) << near_every;
   }
 }
 

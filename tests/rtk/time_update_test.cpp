@@ -53,9 +53,10 @@ TEST(TimeUpdate, AnExternalMotionAddsItsIncrementAndRestartsTheHeadingWhenAskedO
   m.heading_variance_rad2 = 0.01;
   m.heading_noise_rad2 = 1e-6;
   m.dp_d_heading_E_m = Eigen::Vector3d(0.0, 0.5, 0.0);
-  bool live = false;
+  AidingLive live;
   external_motion_update(state, m, live);
-  EXPECT_TRUE(live);
+  EXPECT_TRUE(live.heading);
+  EXPECT_FALSE(live.scale);  // no scale state in this layout
   const int h = state.heading_index();
   EXPECT_NEAR(state.P()(h, h), 0.01 + 1e-6, 1e-15);
   EXPECT_LT((state.position_E_m() - (kPosition + m.delta_p_E_m)).norm(), 1e-9);
@@ -66,6 +67,30 @@ TEST(TimeUpdate, AnExternalMotionAddsItsIncrementAndRestartsTheHeadingWhenAskedO
   m.heading_variance_rad2 = 0.04;
   external_motion_update(state, m, live);
   EXPECT_NEAR(state.P()(h, h), 0.04 + 1e-6, 1e-15);
+}
+
+TEST(TimeUpdate, AScaleStateScalesTheIncrementAndLearnsFromThePosition) {
+  FilterState state({false, false, true});
+  state.reset_kinematics(kPosition, Eigen::Vector3d::Zero(), 1e-6, 0.0);
+  ExternalMotion m;
+  m.delta_p_E_m = Eigen::Vector3d(1.0, 0.0, 0.0);
+  m.scale_variance = 1e-4;
+  m.scale_noise = 1e-8;
+  AidingLive live;
+  external_motion_update(state, m, live);
+  EXPECT_TRUE(live.scale);
+  const int s = state.scale_index();
+  EXPECT_EQ(s, 3);
+  EXPECT_NEAR(state.P()(s, s), 1e-4 + 1e-8, 1e-15);
+  EXPECT_NEAR(state.P()(0, s), 1e-4, 1e-12);  // the position along the increment correlates with the scale
+  EXPECT_NEAR(state.P()(0, 0), 1e-6 + 1e-4, 1e-12);
+  state.set_scale(0.01);
+  external_motion_update(state, m, live);  // p += dp (1 + s)
+  EXPECT_NEAR(state.position_E_m().x() - kPosition.x(), 2.01, 1e-9);
+  m.restart_scale = true;
+  external_motion_update(state, m, live);
+  EXPECT_NEAR(state.P()(s, s), 1e-4 + 1e-8, 1e-15);
+  EXPECT_EQ(state.x()[s], 0.0);
 }
 
 TEST(TimeUpdate, KeyedRandomWalksGrowWithTheInterval) {

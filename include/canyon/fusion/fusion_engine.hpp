@@ -77,6 +77,8 @@ struct FusionStats {
   int widened = 0;                  ///< priors widened after gate_conflict_epochs
   double heading_folded_rad = 0.0;  ///< heading state: the sum of the heading corrections folded into T_EO
   double heading_sigma_rad = 0.0;   ///< heading state: the heading error's sigma after the last aided epoch
+  double scale_error = 0.0;         ///< scale state: the VIO's scale error after the last aided epoch (relative)
+  double scale_sigma = 0.0;         ///< scale state: its sigma
   int integrity_restarts = 0;       ///< integrity check: restarts from the single point
   int heading_free = 0;             ///< heading-free fill-in: epochs it filled
   AlignmentStats alignment;         ///< tries, rejections, accepted alignments, the calibration
@@ -150,6 +152,8 @@ class FusionEngine {
   [[nodiscard]] std::optional<EpochAiding> predict_prior(const core::GpsTime& t, const std::optional<VioPoseAt>& pose);
   [[nodiscard]] std::optional<MotionPrediction> predict_from_vio(const std::optional<VioPoseAt>& pose,
                                                                  rtk::ExternalMotion& motion);
+  /// Beyond the paper: the VIO scale-error state's noise and (re)start (PredictionOptions::scale_state).
+  void couple_scale(rtk::ExternalMotion& motion, const Eigen::Vector3d& dp_E_m, int segment);
   /// The antenna's VIO increment from the track's pose at GPST t_from to `pose` (Eqs. 4-5), nullopt if the track has
   /// no pose at t_from in pose's segment.
   [[nodiscard]] std::optional<VioPoseAt> pose_before(const core::GpsTime& t_from, const VioPoseAt& pose) const;
@@ -186,6 +190,7 @@ class FusionEngine {
   std::optional<EpochAiding> aiding_;                 // from predict() to finish_epoch(): the filter points to it
   std::optional<Eigen::Vector3d> epoch_spp_p_E_m_;    // the epoch's single point, if any
   std::optional<core::Solution> heading_free_epoch_;  // the epoch's heading-free fill-in, from predict()
+  int scale_segment_ = -1;                            // the VIO segment the scale state was learnt on
 };
 
 }  // namespace canyon::fusion

@@ -14,8 +14,11 @@
 namespace canyon::fusion {
 
 struct PriorRecoveryOptions {
-  int max_prior_rejections = 5;   ///< consecutive prior-only validation failures before the float is taken
-  int gate_conflict_epochs = 5;   ///< consecutive epochs gating more rows than used before the prior is widened
+  int max_prior_rejections = 5;  ///< consecutive prior-only validation failures before the float is taken
+  /// Consecutive epochs gating more rows than used before the prior is widened; 0: never (the default: in a street
+  /// canyon the NLOS code rows conflict with a good prior for minutes, and each widening let them pull it tens of
+  /// metres away, docs/results/urban-claim.md).
+  int gate_conflict_epochs = 0;
   double reanchor_sigma_m = 2.0;  ///< the widening (m, per axis)
 
   [[nodiscard]] std::string validate() const;

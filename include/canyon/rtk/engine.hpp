@@ -132,6 +132,12 @@ class RtkEngine {
   /// heading_error(), then the state's value set to zero (its variance and correlations kept): the caller folds the
   /// estimate into the aiding's frame.
   std::optional<HeadingError> take_heading_error();
+  /// The external motion's scale error state (relative) and its variance, when it holds an estimate.
+  struct ScaleError {
+    double s = 0.0;
+    double variance = 0.0;
+  };
+  [[nodiscard]] std::optional<ScaleError> scale_error() const;
   /// Removes every ambiguity and ionosphere state (between epochs): the next epochs start them afresh, as after a
   /// loss of lock on every satellite.
   void reset_ambiguities();
@@ -164,7 +170,7 @@ class RtkEngine {
   std::unique_ptr<PendingEpoch> pending_;
   std::optional<core::GpsTime> last_time_;
   bool initialised_ = false;
-  bool heading_live_ = false;    // the heading error state holds an estimate (aided since its restart)
+  AidingLive live_;              // the aiding error states hold estimates (aided since their restart)
   bool iono_estimated_ = false;  // ionosphere states in use at this epoch
   // The prior of an epoch with an external motion, kept for revert_to_prior().
   struct Prior {

@@ -5,6 +5,7 @@
 //   position      p_E_u (3, ECEF, m)
 //   kinematics    v_E_u, a_E_u (6, m/s and m/s^2; with dynamics)
 //   heading       psi (1, rad; the error of an external aiding's heading, with a heading state)
+//   scale         s (1, relative; the error of an external aiding's scale, with a scale state)
 //   keyed states  one per StateKey, in the order added: an ambiguity N_sd of (satellite, frequency rank) in cycles,
 //                 or a satellite's single-differenced ionosphere I_sd in L1-band metres (frequency kIonosphere).
 // Keyed states come and go every epoch (a satellite rises, a slip resets it); the measurement update and the ambiguity
@@ -36,6 +37,7 @@ struct StateKey {
 struct StateLayout {
   bool kinematics = false;  ///< velocity and acceleration (the constant-acceleration model)
   bool heading = false;     ///< the external aiding's heading error
+  bool scale = false;       ///< the external aiding's scale error
 };
 
 class FilterState {
@@ -52,8 +54,14 @@ class FilterState {
   [[nodiscard]] int kinematics_index() const { return layout_.kinematics ? 3 : -1; }
   /// Index of the heading error; -1 without a heading state.
   [[nodiscard]] int heading_index() const { return layout_.heading ? (layout_.kinematics ? 9 : 3) : -1; }
-  /// Number of unkeyed states (position, kinematics, heading): the index of the first keyed state.
-  [[nodiscard]] int num_unkeyed() const { return 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0); }
+  /// Index of the scale error; -1 without a scale state.
+  [[nodiscard]] int scale_index() const {
+    return layout_.scale ? 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) : -1;
+  }
+  /// Number of unkeyed states (position, kinematics, heading, scale): the index of the first keyed state.
+  [[nodiscard]] int num_unkeyed() const {
+    return 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) + (layout_.scale ? 1 : 0);
+  }
 
   // ---- keyed states ----
   /// Index of a keyed state in x, -1 if absent.
@@ -98,12 +106,23 @@ class FilterState {
   /// Adds q_ambiguity to every ambiguity's variance and q_ionosphere to every ionosphere state's.
   void add_keyed_random_walk(double q_ambiguity, double q_ionosphere);
   /// Restarts the heading error: value 0, variance `variance_rad2`, uncorrelated.
-  void restart_heading(double variance_rad2);
+  void restart_heading(double variance_rad2) { restart_aiding_state(heading_index(), variance_rad2); }
   /// The heading error's share of the position: p += J psi, P = F P F^T with F = I + J e_psi^T, then psi's
   /// variance grows by `noise_rad2`.
-  void couple_heading(const Eigen::Vector3d& J, double noise_rad2);
+  void couple_heading(const Eigen::Vector3d& J, double noise_rad2) {
+    couple_aiding_state(heading_index(), J, noise_rad2);
+  }
+  /// The same for the scale error s (J = the increment itself: p += dp s).
+  void restart_scale(double variance) { restart_aiding_state(scale_index(), variance); }
+  void couple_scale(const Eigen::Vector3d& J, double noise) { couple_aiding_state(scale_index(), J, noise); }
   /// Sets the heading error's value (its variance and correlations kept).
   void set_heading(double psi_rad) { x_[heading_index()] = psi_rad; }
+  /// Sets the scale error's value (its variance and correlations kept).
+  void set_scale(double s) { x_[scale_index()] = s; }
+  /// An aiding error state (heading or scale) at `index` restarted: value 0, the variance, uncorrelated.
+  void restart_aiding_state(int index, double variance);
+  /// Its share of the position: p += J x_i, P = F P F^T with F = I + J e_i^T, then its variance grows by `noise`.
+  void couple_aiding_state(int index, const Eigen::Vector3d& J, double noise);
   /// Sets the position, uncorrelated with every other state.
   void set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2);
 

@@ -62,6 +62,8 @@ struct RtkOptions {
   gnss::SppOptions spp;                 ///< single-point solution (prior and fallback)
   /// A heading-error state of the external aiding (see above); set by the aiding's owner (the fusion), not in YAML.
   bool aiding_heading_state = false;
+  /// A scale-error state of the external aiding (time_update.hpp); set by the aiding's owner, not in YAML.
+  bool aiding_scale_state = false;
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;

@@ -12,7 +12,8 @@
 // heading state, psi (the error of the aiding frame's heading) rotates the increment about the local vertical:
 // p += dp + J psi with J = dp_d_heading_E_m (= up x dp), P' = F P F^T with F = I + J e_psi^T, and psi walks by
 // heading_noise_rad2; it restarts (value 0, variance heading_variance_rad2, uncorrelated) when the aiding asks and
-// after any epoch that was not aided.
+// after any epoch that was not aided. With a scale state, s (the increment's relative scale error) adds dp s the same
+// way (J = dp) and walks by scale_noise; it restarts likewise (variance scale_variance).
 // Either way the ambiguities and ionosphere states are random walks: ambiguity_noise_cyc^2 dt, iono_noise_m^2 dt.
 
 #include <Eigen/Core>
@@ -32,14 +33,24 @@ struct ExternalMotion {
   double heading_noise_rad2 = 0.0;     ///< random walk of the heading error over this increment (rad^2)
   double heading_variance_rad2 = 0.0;  ///< variance of the heading error when its state (re)starts (rad^2)
   bool restart_heading = false;        ///< the aiding frame changed (a new alignment): restart the heading state
+  // With RtkOptions::aiding_scale_state only (the increment's scale error s: p += dp (1 + s), s a slow random walk):
+  double scale_noise = 0.0;     ///< random walk of the scale error over this increment (relative^2)
+  double scale_variance = 0.0;  ///< variance of the scale error when its state (re)starts (relative^2)
+  bool restart_scale = false;   ///< the aiding itself changed (a new odometry segment): restart the scale state
 };
 
 /// The own motion model over dt_s; `reinitialise` (no estimate yet) starts the position from `spp`.
 void own_motion_update(FilterState& state, const RtkOptions& options, double dt_s, bool reinitialise,
                        const gnss::SppSolution& spp);
 
-/// The external motion; `heading_live` (the heading state holds an estimate) is read and set.
-void external_motion_update(FilterState& state, const ExternalMotion& motion, bool& heading_live);
+/// Whether the aiding error states hold an estimate (aided since their restart).
+struct AidingLive {
+  bool heading = false;
+  bool scale = false;
+};
+
+/// The external motion; `live` is read and set.
+void external_motion_update(FilterState& state, const ExternalMotion& motion, AidingLive& live);
 
 /// The random walks of the keyed states over dt_s.
 void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_s);
