@@ -107,6 +107,7 @@ ProcessConfig process_defaults(ProcessMode mode) {
     c.rtk.float_consistency_level = 0.001;
     c.rtk.snr_weighting = true;
     c.rtk.ambiguity_noise_cyc = 0.01;
+    c.rtk.iono_noise_m = 3e-5;
   }
   return c;
 }

@@ -823,13 +823,14 @@ TEST(FloatConsistencyTest, AFloatThatFitsNoIntegersFixesNothingInAMidRiseCanyon)
   // metres that holds for minutes, which the filter takes as white noise; its float claims centimetres while it is
   // decimetres off, its integer search finds no vector that fits and, with the success rate of that claimed
   // covariance, fix-and-hold held a wrong set (121 wrong fixes, even with the ambiguity random walk that bounds what
-  // the float learns from the code). That was with the VIO's covariance as reported and the prior widened after
-  // gate conflicts; with fusion.yaml's sigma factor 2 and no widening this seed fixes nothing either way, so the test
-  // takes the former set-up in both runs.
+  // the float learns from the code). That was with the VIO's covariance as reported, the prior widened after gate
+  // conflicts and rtk.yaml's ionosphere walk; with fusion.yaml's set-up this seed fixes nothing either way, so the
+  // test takes the former set-up in both runs.
   const auto runs =
       with_and_without("urban-moderate", 9, 600.0, "consistency", no_consistency_test, [](config::ProcessConfig& c) {
         c.fusion.prediction.vio_sigma_factor = 1.0;
         c.fusion.recovery.gate_conflict_epochs = 5;
+        c.rtk.iono_noise_m = 0.001;
       });
   ASSERT_TRUE(runs);
   const auto& [with, without] = *runs;
