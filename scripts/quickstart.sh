@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sets canyon up on a fresh Debian 12 machine (packages, build) and runs its main job on the built-in default, with
-# no external data: `canyon demo` generates the urban-severe street-canyon scenario (10 minutes, pedestrian, 20 km
-# base), processes it with canyon's SPP and RTK modes and with RTKLIB's rnx2rtkp, scores all three against the
-# scenario's exact truth, prints the side-by-side table and writes the plots into out/demo/.
+# no external data: `canyon demo` generates the downtown street-canyon scenario (10 minutes, pedestrian, 20 km base),
+# processes it with canyon's SPP, RTK and fusion modes and with RTKLIB's rnx2rtkp, scores all four against the
+# scenario's exact truth (fix rate and correct-fix rate), prints the side-by-side table and writes the plots into
+# out/demo/.
 # Usage: scripts/quickstart.sh [BUILD_DIR] [canyon demo options...]     (default: <repo>/build)
 set -euo pipefail
 

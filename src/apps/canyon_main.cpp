@@ -515,10 +515,10 @@ struct DemoArgs {
 void add_demo_command(CLI::App& app, DemoArgs& args) {
   CLI::App* cmd = app.add_subcommand(
       "demo",
-      "canyon's main job, no external data: generate urban-severe, process it with SPP, RTK, fusion (VIO) and RTKLIB, "
+      "canyon's main job, no external data: generate downtown, process it with SPP, RTK, fusion (VIO) and RTKLIB, "
       "evaluate");
   canyon::commands::DemoConfig& c = args.config;
-  cmd->add_option("--scenario", c.scenario, "Shipped scenario name or a FILE.yaml (default urban-severe)");
+  cmd->add_option("--scenario", c.scenario, "Shipped scenario name or a FILE.yaml (default downtown)");
   cmd->add_option("--seed", args.seed, "Random seed (default: the scenario's)")->check(CLI::Range(0LL, 1LL << 53));
   cmd->add_option("--duration", args.duration_s, "Duration in seconds (default: the scenario's, 600)")
       ->check(CLI::Range(1.0, 86400.0));

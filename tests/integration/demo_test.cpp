@@ -1,4 +1,4 @@
-// `canyon demo` end to end (a 2-minute urban-severe scenario instead of the default 10): every stage runs, RTKLIB
+// `canyon demo` end to end (a 2-minute downtown scenario instead of the default 10): every stage runs, RTKLIB
 // included, and the table, Markdown, JSON and plots come out; the README's first command runs this with defaults.
 
 #include <fstream>

@@ -1,6 +1,6 @@
 #pragma once
 // `canyon demo`: canyon's main job on a built-in default, with no external data. Generates a scenario
-// (urban-severe unless told otherwise), processes it with every mode canyon has (SPP, RTK, fusion), runs RTKLIB's
+// (downtown unless told otherwise: the walk calibrated to the paper's UC2 by RTKLIB), processes it with every mode canyon has (SPP, RTK, fusion), runs RTKLIB's
 // `rnx2rtkp` on the same files as the baseline when it is installed, and scores everything against the scenario's
 // truth: the side-by-side table (RTKLIB : canyon) and the plots of `canyon evaluate`.
 //
@@ -23,7 +23,7 @@
 namespace canyon::commands {
 
 struct DemoConfig {
-  std::string scenario = "urban-severe";          ///< shipped scenario name or a scenario file
+  std::string scenario = "downtown";              ///< shipped scenario name or a scenario file
   std::optional<std::uint64_t> seed;              ///< default: the scenario's
   std::optional<double> duration_s;               ///< default: the scenario's
   std::string out_dir = "out/demo";               ///< created if needed
@@ -41,7 +41,7 @@ struct DemoSummary {
   std::vector<std::string> written;  ///< result files (the scenario's files are in DIR/scenario)
 };
 
-/// Called with one line per stage ("simulate urban-severe (seed 1, 600 s)").
+/// Called with one line per stage ("simulate downtown (seed 1, 600 s)").
 using DemoLog = std::function<void(const std::string&)>;
 
 /// Runs the demo. Error if a stage fails (a shipped configuration is missing, RTKLIB fails, a file cannot be
