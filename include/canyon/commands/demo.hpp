@@ -1,8 +1,9 @@
 #pragma once
 // `canyon demo`: canyon's main job on a built-in default, with no external data. Generates a scenario
-// (downtown unless told otherwise: the walk calibrated to the paper's UC2 by RTKLIB), processes it with every mode canyon has (SPP, RTK, fusion), runs RTKLIB's
-// `rnx2rtkp` on the same files as the baseline when it is installed, and scores everything against the scenario's
-// truth: the side-by-side table (RTKLIB : canyon) and the plots of `canyon evaluate`.
+// (downtown unless told otherwise: the walk calibrated to the paper's UC2 by RTKLIB), processes it with every mode
+// canyon has (SPP, RTK, fusion), runs RTKLIB's `rnx2rtkp` on the same files as the baseline when it is installed, and
+// scores everything against the scenario's truth: the side-by-side table (RTKLIB : canyon) and the plots of `canyon
+// evaluate`.
 //
 // Files (DIR):
 //   scenario/        the generated scenario (canyon simulate's files)
