@@ -356,8 +356,8 @@ void add_simulate_command(CLI::App& app, SimulateArgs& args) {
       "simulate", "Generate a scenario: rover and base RINEX, navigation, ground truth and city model");
   cmd->add_option(
       "--scenario", args.scenario,
-      "Shipped scenario name (open-sky, light-blocked, urban-moderate, urban-severe, downtown, downtown-vehicle) or a "
-      "FILE.yaml (with --vio-from-truth: its vio section, default urban-severe's)");
+      "Shipped scenario name (open-sky, light-blocked, urban-moderate, urban-severe, downtown-mild, downtown, "
+      "downtown-vehicle) or a FILE.yaml (with --vio-from-truth: its vio section, default urban-severe's)");
   cmd->add_option("--vio-from-truth", args.vio_from_truth,
                   "Only make VIO (vio.csv, timesync.csv, vio_truth.yaml) of a device carried along this 6-DoF truth: "
                   "canyon truth.csv with qx,qy,qz,qw, or a Spirent PVA CSV with roll, pitch, yaw")
