@@ -47,12 +47,6 @@ VioIncrement vio_increment(const core::Pose& T_OI_a, const core::Pose& T_OI_b, c
   return inc;
 }
 
-Eigen::Matrix3d vio_error_beyond_covariance(const VioIncrement& increment, const Eigen::Matrix3d& R_EO,
-                                            const PredictionOptions& options) {
-  const double k2 = options.vio_sigma_factor * options.vio_sigma_factor;
-  return (k2 - 1.0) * R_EO * increment.cov_O_m2 * R_EO.transpose();
-}
-
 MotionPrediction predict_with_vio(const VioPredictionInput& in, const PredictionOptions& options,
                                   std::optional<double> widen_sigma_m) {
   MotionPrediction prediction;
@@ -60,8 +54,10 @@ MotionPrediction predict_with_vio(const VioPredictionInput& in, const Prediction
                                        in.up_E);  // Eqs. 4-5
   prediction.dp_E_m = prediction.increment.dp_E_m;
   if (options.vio_covariance) {
+    // Beyond the paper: the VIO's own part taken times vio_sigma_factor^2 (the alignment's yaw part as it is).
+    const double k2 = options.vio_sigma_factor * options.vio_sigma_factor;
     prediction.Q_E_m2 =
-        prediction.increment.cov_E_m2 + vio_error_beyond_covariance(prediction.increment, in.R_EO, options);
+        prediction.increment.cov_E_m2 + (k2 - 1.0) * in.R_EO * prediction.increment.cov_O_m2 * in.R_EO.transpose();
   } else {
     prediction.Q_E_m2 =
         Eigen::Matrix3d::Identity() * options.constant_increment_sigma_m * options.constant_increment_sigma_m;

@@ -281,7 +281,7 @@ std::optional<RtkEngine::ScaleError> RtkEngine::scale_error() const {
 
 std::optional<RtkEngine::HeadingError> RtkEngine::take_heading_error() {
   std::optional<HeadingError> heading = heading_error();
-  if (heading) state_.set_heading(0.0);
+  if (heading) state_.set_aiding_value(state_.heading_index(), 0.0);
   return heading;
 }
 

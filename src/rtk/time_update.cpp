@@ -29,22 +29,27 @@ void own_motion_update(FilterState& state, const RtkOptions& options, double dt_
   state.add_acceleration_noise(R_EN, Q_N);
 }
 
+namespace {
+
+/// One aiding error state (absent: index < 0): restarted when asked or not live, then coupled into the position.
+void aiding_state_update(FilterState& state, int index, bool restart, double variance, const Eigen::Vector3d& J,
+                         double noise, bool& live) {
+  if (index < 0) return;
+  if (restart || !live) {
+    state.restart_aiding_state(index, variance);
+    live = true;
+  }
+  state.couple_aiding_state(index, J, noise);
+}
+
+}  // namespace
+
 void external_motion_update(FilterState& state, const ExternalMotion& motion, AidingLive& live) {
   state.add_position_increment(motion.delta_p_E_m, motion.Q_E_m2);
-  if (state.heading_index() >= 0) {
-    if (motion.restart_heading || !live.heading) {
-      state.restart_heading(motion.heading_variance_rad2);
-      live.heading = true;
-    }
-    state.couple_heading(motion.dp_d_heading_E_m, motion.heading_noise_rad2);
-  }
-  if (state.scale_index() >= 0) {
-    if (motion.restart_scale || !live.scale) {
-      state.restart_scale(motion.scale_variance);
-      live.scale = true;
-    }
-    state.couple_scale(motion.delta_p_E_m, motion.scale_noise);
-  }
+  aiding_state_update(state, state.heading_index(), motion.restart_heading, motion.heading_variance_rad2,
+                      motion.dp_d_heading_E_m, motion.heading_noise_rad2, live.heading);
+  aiding_state_update(state, state.scale_index(), motion.restart_scale, motion.scale_variance, motion.delta_p_E_m,
+                      motion.scale_noise, live.scale);
 }
 
 void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_s) {

@@ -124,16 +124,16 @@ TEST(FilterState, ResetKinematicsDecorrelatesThePositionAndAnIncrementKeepsItsCo
 
 TEST(FilterState, HeadingCouplingIsFPFtWithFTheIdentityPlusJTimesPsi) {
   FilterState s = filled_state({false, true}, 4);
-  s.restart_heading(0.01);
+  s.restart_aiding_state(s.heading_index(), 0.01);
   const Eigen::Index h = s.heading_index();
   EXPECT_DOUBLE_EQ(s.x()[h], 0.0);
   EXPECT_TRUE(s.P().row(h).head(h).isZero());
-  s.set_heading(0.02);  // a value, so that the mean moves too
+  s.set_aiding_value(s.heading_index(), 0.02);  // a value, so that the mean moves too
   const Eigen::VectorXd x0 = s.x();
   const Eigen::MatrixXd P0 = s.P();
   const Eigen::Vector3d J(1.0, -0.5, 0.2);
   const double noise = 1e-6;
-  s.couple_heading(J, noise);
+  s.couple_aiding_state(s.heading_index(), J, noise);
   Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.size(), s.size());
   F.block(0, h, 3, 1) = J;
   Eigen::MatrixXd expected = F * P0 * F.transpose();

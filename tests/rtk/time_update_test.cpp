@@ -84,7 +84,7 @@ TEST(TimeUpdate, AScaleStateScalesTheIncrementAndLearnsFromThePosition) {
   EXPECT_NEAR(state.P()(s, s), 1e-4 + 1e-8, 1e-15);
   EXPECT_NEAR(state.P()(0, s), 1e-4, 1e-12);  // the position along the increment correlates with the scale
   EXPECT_NEAR(state.P()(0, 0), 1e-6 + 1e-4, 1e-12);
-  state.set_scale(0.01);
+  state.set_aiding_value(s, 0.01);
   external_motion_update(state, m, live);  // p += dp (1 + s)
   EXPECT_NEAR(state.position_E_m().x() - kPosition.x(), 2.01, 1e-9);
   m.restart_scale = true;

@@ -92,10 +92,6 @@ struct VioPredictionInput {
   Eigen::Vector3d up_E = Eigen::Vector3d::UnitZ();
 };
 
-/// What the VIO's covariance leaves out by its over-confidence (vio_sigma_factor): added to the increment's cov_E_m2.
-[[nodiscard]] Eigen::Matrix3d vio_error_beyond_covariance(const VioIncrement& increment, const Eigen::Matrix3d& R_EO,
-                                                          const PredictionOptions& options);
-
 /// Algorithm 1, lines 3-5: Eqs. 4-5 (the increment and its covariance), then Eqs. 3 and 6 (the prior), the increment's
 /// covariance taken times vio_sigma_factor^2. `widen_sigma_m` (prior_recovery.hpp) adds its square to the increment's
 /// covariance per axis.

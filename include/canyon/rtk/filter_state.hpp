@@ -105,24 +105,13 @@ class FilterState {
   void add_position_increment(const Eigen::Vector3d& dp_E_m, const Eigen::Matrix3d& Q_E_m2);
   /// Adds q_ambiguity to every ambiguity's variance and q_ionosphere to every ionosphere state's.
   void add_keyed_random_walk(double q_ambiguity, double q_ionosphere);
-  /// Restarts the heading error: value 0, variance `variance_rad2`, uncorrelated.
-  void restart_heading(double variance_rad2) { restart_aiding_state(heading_index(), variance_rad2); }
-  /// The heading error's share of the position: p += J psi, P = F P F^T with F = I + J e_psi^T, then psi's
-  /// variance grows by `noise_rad2`.
-  void couple_heading(const Eigen::Vector3d& J, double noise_rad2) {
-    couple_aiding_state(heading_index(), J, noise_rad2);
-  }
-  /// The same for the scale error s (J = the increment itself: p += dp s).
-  void restart_scale(double variance) { restart_aiding_state(scale_index(), variance); }
-  void couple_scale(const Eigen::Vector3d& J, double noise) { couple_aiding_state(scale_index(), J, noise); }
-  /// Sets the heading error's value (its variance and correlations kept).
-  void set_heading(double psi_rad) { x_[heading_index()] = psi_rad; }
-  /// Sets the scale error's value (its variance and correlations kept).
-  void set_scale(double s) { x_[scale_index()] = s; }
-  /// An aiding error state (heading or scale) at `index` restarted: value 0, the variance, uncorrelated.
+  /// An aiding error state (heading_index() or scale_index()) restarted: value 0, the variance, uncorrelated.
   void restart_aiding_state(int index, double variance);
   /// Its share of the position: p += J x_i, P = F P F^T with F = I + J e_i^T, then its variance grows by `noise`.
+  /// The heading error psi: J = up x dp (rad); the scale error s: J = dp.
   void couple_aiding_state(int index, const Eigen::Vector3d& J, double noise);
+  /// Sets an aiding error state's value (its variance and correlations kept).
+  void set_aiding_value(int index, double value) { x_[index] = value; }
   /// Sets the position, uncorrelated with every other state.
   void set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2);
 
