@@ -2,6 +2,7 @@
 
 #include "canyon/config/yaml_reader.hpp"
 
+#include <set>
 #include <utility>
 
 namespace canyon::config {
@@ -153,10 +154,15 @@ void YamlMap::fail(const std::string& key, const std::string& message) {
 
 void YamlMap::reject_unknown_keys() {
   if (!node_ || !node_.IsMap()) return;
+  std::set<std::string> seen;
   for (const auto& item : node_) {
     const std::string key = item.first.Scalar();
+    const int line = item.first.Mark().line + 1;
     if (asked_.count(key) == 0) {
-      errors_->push_back(Error{"unknown key '" + key_path(key) + "'", file_, item.first.Mark().line + 1});
+      errors_->push_back(Error{"unknown key '" + key_path(key) + "'", file_, line});
+    } else if (!seen.insert(key).second) {
+      // YAML maps have unique keys; yaml-cpp keeps both and reads the first, so the second would be ignored silently.
+      errors_->push_back(Error{"duplicate key '" + key_path(key) + "' (given earlier in the same map)", file_, line});
     }
   }
 }

@@ -254,6 +254,9 @@ TEST(ProcessConfigTest, RejectsBadConfigsNamingKeyAndLine) {
       {"spp: 5\n", "'spp' must be a map", 1},
       {"- a\n- b\n", "top level must be a map", 1},
       {"rtk:\n  ionosphere: sometimes\n", "'rtk.ionosphere' must be off, estimate or auto", 2},
+      // A second section or key of one name would be ignored (yaml-cpp reads the first): an error instead.
+      {"rtk:\n  code_phase_ratio: 100\nrtk:\n  code_phase_ratio: 300\n", "duplicate key 'rtk'", 3},
+      {"spp:\n  elevation_mask_deg: 15\n  elevation_mask_deg: 10\n", "duplicate key 'spp.elevation_mask_deg'", 3},
   };
   for (const auto& c : cases) {
     auto config = parse(c.yaml);
