@@ -243,19 +243,25 @@ Matrix12d VioTrack::joint_covariance(const VioPoseAt& a, const VioPoseAt& b) con
           J[static_cast<std::size_t>(v)]->transpose();
     }
   }
-  out.topLeftCorner<3, 3>().diagonal().array() += interpolation_variance_m2(a);
-  out.block<3, 3>(6, 6).diagonal().array() += interpolation_variance_m2(b);
+  const double sigma_a_m = interpolation_sigma_m(a);
+  const double sigma_b_m = interpolation_sigma_m(b);
+  out.topLeftCorner<3, 3>().diagonal().array() += sigma_a_m * sigma_a_m;
+  out.block<3, 3>(6, 6).diagonal().array() += sigma_b_m * sigma_b_m;
+  if (a.lower == b.lower) {
+    // One interval, one missed acceleration: the two interpolation errors are fully correlated.
+    out.block<3, 3>(0, 6).diagonal().array() += sigma_a_m * sigma_b_m;
+    out.block<3, 3>(6, 0).diagonal().array() += sigma_a_m * sigma_b_m;
+  }
   return 0.5 * (out + out.transpose());
 }
 
-double VioTrack::interpolation_variance_m2(const VioPoseAt& p) const {
+double VioTrack::interpolation_sigma_m(const VioPoseAt& p) const {
   if (!(options_.interpolation_accel_mps2 > 0.0)) return 0.0;
   const int upper = p.lower + 1;
   if (p.lower < forgotten_ || upper - forgotten_ >= static_cast<int>(samples_.size())) return 0.0;
   const double dt_s = sample(upper).t_s - sample(p.lower).t_s;
   const double x = std::clamp(p.a, 0.0, 1.0);
-  const double sigma_m = options_.interpolation_accel_mps2 * x * (1.0 - x) * dt_s * dt_s / 2.0;
-  return sigma_m * sigma_m;
+  return options_.interpolation_accel_mps2 * x * (1.0 - x) * dt_s * dt_s / 2.0;
 }
 
 core::Matrix6d VioTrack::covariance(const VioPoseAt& a) const {

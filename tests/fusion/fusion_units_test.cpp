@@ -200,6 +200,29 @@ TEST(VioTrackTest, InterpolatedPosesCarryTheInterpolationError) {
   EXPECT_NE(negative.validate().find("interpolation_accel_mps2"), std::string::npos);
 }
 
+// Two poses in one interval share the acceleration the interpolation misses: their errors are fully correlated, so
+// the increment between them gets only the difference of their sigmas; poses in different intervals get both.
+TEST(VioTrackTest, PosesInOneIntervalShareTheirInterpolationError) {
+  const core::GpsTime ref{2266, 100.0};
+  VioTrackOptions exact;
+  exact.interpolation_accel_mps2 = 0.0;
+  const VioTrackOptions honest;  // q = 1 m/s^2
+  const double dt_s = 1.0;       // a 1 Hz stream
+  const std::vector<VioTrackSample> s = straight_samples(20, dt_s, 1.4);
+  const VioTrack with = VioTrack::from_samples(s, ref, honest);
+  const VioTrack without = VioTrack::from_samples(s, ref, exact);
+  const auto sigma_at = [&](double x) { return honest.interpolation_accel_mps2 * x * (1.0 - x) * dt_s * dt_s / 2.0; };
+  const auto added_increment_variance = [&](double ta, double tb) {
+    const auto a = with.pose_at(ref + ta), b = with.pose_at(ref + tb);
+    const auto a0 = without.pose_at(ref + ta), b0 = without.pose_at(ref + tb);
+    const Matrix12d added = with.joint_covariance(*a, *b) - without.joint_covariance(*a0, *b0);
+    // x-axis variance of the increment p(b) - p(a): var(a) + var(b) - 2 cov(a, b).
+    return added(0, 0) + added(6, 6) - 2.0 * added(0, 6);
+  };
+  EXPECT_NEAR(added_increment_variance(5.2, 5.6), std::pow(sigma_at(0.6) - sigma_at(0.2), 2), 1e-15);
+  EXPECT_NEAR(added_increment_variance(5.8, 6.2), std::pow(sigma_at(0.8), 2) + std::pow(sigma_at(0.2), 2), 1e-15);
+}
+
 TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   std::vector<VioTrackSample> s = straight_samples(40, 0.1, 1.4);
   for (int k = 10; k < 40; ++k) s[static_cast<std::size_t>(k)].t_s += 1.0;           // a 1.1 s gap before sample 10

@@ -50,7 +50,9 @@ struct VioTrackOptions {
   bool use_cross_covariance = true;      ///< false: consecutive-pose cross-covariances taken as zero
   /// Acceleration the constant-twist interpolation between two poses misses (1 sigma, m/s^2): a pose interpolated at
   /// fraction x of an interval dt gets a position variance (q x (1 - x) dt^2 / 2)^2 per axis (q dt^2 / 8 at the
-  /// midpoint: 1.25 mm at 10 Hz, 12.5 cm at 1 Hz for q = 1). 0: interpolation taken as exact.
+  /// midpoint: 1.25 mm at 10 Hz, 12.5 cm at 1 Hz for q = 1). Two poses in one interval share its missed
+  /// acceleration, so their errors are fully correlated (an increment within an interval gets only the difference);
+  /// poses in different intervals are taken as independent. 0: interpolation taken as exact.
   double interpolation_accel_mps2 = 1.0;
 
   [[nodiscard]] std::string validate() const;
@@ -131,8 +133,8 @@ class VioTrack {
       : samples_(std::move(samples)), reference_(reference), options_(options) {}
   /// cov(xi_k, xi_l) for samples k <= l of one segment (indices as in VioPoseAt).
   [[nodiscard]] core::Matrix6d sample_covariance(int k, int l) const;
-  /// Position variance per axis of the interpolation error of `p` (interpolation_accel_mps2).
-  [[nodiscard]] double interpolation_variance_m2(const VioPoseAt& p) const;
+  /// Position sigma per axis of the interpolation error of `p` (interpolation_accel_mps2).
+  [[nodiscard]] double interpolation_sigma_m(const VioPoseAt& p) const;
   [[nodiscard]] const VioTrackSample& sample(int index) const {
     return samples_[static_cast<std::size_t>(index - forgotten_)];
   }
