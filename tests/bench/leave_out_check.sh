@@ -7,7 +7,8 @@
 #
 # Usage: tests/bench/leave_out_check.sh [BUILD_DIR]
 # Environment: CANYON_SHARED_DATA_DIR (default ../shared/data), KEEP=1 keeps the temp folder, ONLY=REGEX selects rows,
-# EXTRA_YAML=FILE appends its keys to every configuration (e.g. a candidate setting).
+# EXTRA_YAML=FILE appends its lines to every configuration, whose last section is rtk: indented keys of a candidate
+# setting (e.g. "  snr_weighting: true"); a key the configuration has already is an error (duplicate key).
 # Output: per dataset the check's table, then one summary row each. Exit 0 when every dataset passes both criteria,
 # 1 when one does not or a run fails, 2 missing build or tools, 77 (SKIP:) no shared data.
 set -euo pipefail
