@@ -41,6 +41,15 @@ std::vector<FilterState::NewState> AmbiguityStates::admit(std::vector<SingleDiff
     sd.fixable = !half_cycle && glonass_ok && a.lock_epochs > options.min_lock_epochs &&
                  sd.elevation_rad >= options.ar_elevation_mask_rad;
   }
+  if (options.code_multipath_sigma_m > 0.0) {
+    const double variance = options.code_multipath_sigma_m * options.code_multipath_sigma_m;
+    for (const SingleDiff& sd : sds) {
+      if (!core::has_value(sd.code_m)) continue;
+      const StateKey key = StateKey::code_bias(sd.sat, sd.frequency);
+      if (!has_state(key)) new_states.push_back(FilterState::NewState{key, 0.0, variance});
+      info_[key].last_seen = t;
+    }
+  }
   if (iono_sigma_m) {
     for (const SingleDiff& sd : sds) {
       const StateKey key{sd.sat, StateKey::kIonosphere};
@@ -55,6 +64,7 @@ void assign_state_indices(std::vector<SingleDiff>& sds, const FilterState& state
   for (SingleDiff& sd : sds) {
     sd.ambiguity = core::has_value(sd.phase_m) ? state.index({sd.sat, sd.frequency}) : -1;
     sd.iono = state.index({sd.sat, StateKey::kIonosphere});
+    sd.code_bias = state.index(StateKey::code_bias(sd.sat, sd.frequency));
   }
 }
 

@@ -29,6 +29,14 @@ DdRow form_row(const FilterState& state, const std::vector<SingleDiff>& sds, int
     observed_m = sd.phase_m - ref.phase_m;
   } else {
     observed_m = sd.code_m - ref.code_m;
+    if (sd.code_bias >= 0) {
+      row.add(sd.code_bias, 1.0);
+      predicted_m += x[sd.code_bias];
+    }
+    if (ref.code_bias >= 0) {
+      row.add(ref.code_bias, -1.0);
+      predicted_m -= x[ref.code_bias];
+    }
   }
   if (sd.iono >= 0 && ref.iono >= 0) {
     // The ionosphere advances phase and delays code by iono_scale * I_sd.

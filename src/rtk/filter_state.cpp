@@ -110,7 +110,19 @@ void FilterState::add_position_increment(const Eigen::Vector3d& dp_E_m, const Ei
 void FilterState::add_keyed_random_walk(double q_ambiguity, double q_ionosphere) {
   const int k = num_unkeyed();
   for (Eigen::Index i = k; i < x_.size(); ++i) {
-    P_(i, i) += keys_[static_cast<std::size_t>(i - k)].ionosphere() ? q_ionosphere : q_ambiguity;
+    const StateKey& key = keys_[static_cast<std::size_t>(i - k)];
+    if (!key.code_bias()) P_(i, i) += key.ionosphere() ? q_ionosphere : q_ambiguity;
+  }
+}
+
+void FilterState::propagate_code_biases(double phi, double q) {
+  const int k = num_unkeyed();
+  for (Eigen::Index i = k; i < x_.size(); ++i) {
+    if (!keys_[static_cast<std::size_t>(i - k)].code_bias()) continue;
+    x_[i] *= phi;
+    P_.row(i) *= phi;
+    P_.col(i) *= phi;
+    P_(i, i) += q;
   }
 }
 

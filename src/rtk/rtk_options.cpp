@@ -2,6 +2,8 @@
 
 #include "canyon/rtk/rtk_options.hpp"
 
+#include <cmath>
+
 #include "canyon/core/constants.hpp"
 
 namespace canyon::rtk {
@@ -44,6 +46,12 @@ std::string RtkOptions::validate() const {
   if (!(iono_auto_baseline_km >= 0.0)) return "iono_auto_baseline_km must be >= 0";
   if (max_pruned_satellites < 0) return "max_pruned_satellites must be >= 0";
   if (!(phase_sigma_m > 0.0) || !(code_phase_ratio > 0.0)) return "phase_sigma_m and code_phase_ratio must be > 0";
+  if (!(code_multipath_sigma_m >= 0.0 && std::isfinite(code_multipath_sigma_m))) {
+    return "code_multipath_sigma_m must be finite and >= 0";
+  }
+  if (!(code_multipath_correlation_s > 0.0 && std::isfinite(code_multipath_correlation_s))) {
+    return "code_multipath_correlation_s must be finite and > 0";
+  }
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
   if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";

@@ -2,6 +2,8 @@
 
 #include "canyon/rtk/time_update.hpp"
 
+#include <cmath>
+
 #include "canyon/core/geodesy.hpp"
 
 namespace canyon::rtk {
@@ -56,6 +58,11 @@ void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_
   const double q_amb = options.ambiguity_noise_cyc * options.ambiguity_noise_cyc * dt_s;
   const double q_iono = options.iono_noise_m * options.iono_noise_m * dt_s;
   state.add_keyed_random_walk(q_amb, q_iono);
+  if (options.code_multipath_sigma_m > 0.0) {
+    const double phi = std::exp(-dt_s / options.code_multipath_correlation_s);
+    const double s2 = options.code_multipath_sigma_m * options.code_multipath_sigma_m;
+    state.propagate_code_biases(phi, s2 * (1.0 - phi * phi));
+  }
 }
 
 }  // namespace canyon::rtk

@@ -63,5 +63,27 @@ TEST(AmbiguityStates, StaleAfterAnOutageAndIonosphereStatesWithTheirPrior) {
   EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 5U);
 }
 
+TEST(AmbiguityStates, CodeMultipathStatesComeWithEachSignalsCodeAndTheirSigma) {
+  testing::SyntheticEpoch e = testing::synthetic_epoch(3, Eigen::Vector3d::Zero(), 1.0, 1.0,
+                                                       [](int, int integer) { return static_cast<double>(integer); });
+  e.sds[2].code_m = core::kNoValue;  // no code: no code state (and no new ambiguity)
+  FilterState state({false, false});
+  RtkOptions o;
+  o.code_multipath_sigma_m = 0.7;
+  AmbiguityStates book;
+  const auto added = book.admit(e.sds, state, at(10.0), SlipScan{}, o, std::nullopt);
+  ASSERT_EQ(added.size(), 4U);  // two ambiguities, then two code states
+  for (std::size_t k = 2; k < 4; ++k) {
+    EXPECT_EQ(added[k].key, StateKey::code_bias(e.sds[k - 2].sat, e.sds[k - 2].frequency));
+    EXPECT_DOUBLE_EQ(added[k].value, 0.0);
+    EXPECT_DOUBLE_EQ(added[k].variance, 0.49);
+  }
+  state.add(added);
+  assign_state_indices(e.sds, state);
+  EXPECT_EQ(e.sds[1].code_bias, state.index(StateKey::code_bias(e.sds[1].sat, 0)));
+  EXPECT_EQ(e.sds[2].code_bias, -1);
+  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 4U);  // stale with the others
+}
+
 }  // namespace
 }  // namespace canyon::rtk

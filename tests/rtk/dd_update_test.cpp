@@ -37,6 +37,30 @@ TEST(DdUpdate, RowsAreFormedAgainstTheHighestSatelliteOfTheGroup) {
   }
 }
 
+// A code multipath state enters its signal's code rows (+1, the reference's -1) and nothing else.
+TEST(DdUpdate, CodeRowsCarryTheCodeMultipathStates) {
+  testing::SyntheticEpoch e = epoch(4);
+  std::vector<FilterState::NewState> added;
+  for (const SingleDiff& sd : e.sds) added.push_back({StateKey::code_bias(sd.sat, sd.frequency), 0.0, 1.0});
+  e.state.add(added);
+  for (SingleDiff& sd : e.sds) sd.code_bias = e.state.index(StateKey::code_bias(sd.sat, sd.frequency));
+  Eigen::VectorXd x = e.state.x();
+  x[e.sds[2].code_bias] = 0.7;  // the filter's estimate of satellite 3's code error, which the code carries
+  e.state.restore_values(x, e.state.P());
+  e.sds[2].code_m += 0.7;
+  for (const DdRow& row : dd_rows(e.state, e.sds)) {
+    EXPECT_NEAR(row.innovation_m, row.h_pos.dot(kOffsetM), 1e-9);  // the code error predicted away
+    int code_entries = 0;
+    for (int k = 0; k < row.num_entries; ++k) {
+      const auto [index, coefficient] = row.entries[static_cast<std::size_t>(k)];
+      if (!e.state.key_at(index).code_bias()) continue;
+      ++code_entries;
+      EXPECT_DOUBLE_EQ(coefficient, index == e.sds[static_cast<std::size_t>(row.sd)].code_bias ? 1.0 : -1.0);
+    }
+    EXPECT_EQ(code_entries, row.phase ? 0 : 2);
+  }
+}
+
 TEST(DdUpdate, TheUpdateBringsThePriorToTheTruth) {
   testing::SyntheticEpoch e = epoch();
   std::vector<core::SatelliteId> rejected;

@@ -193,5 +193,33 @@ TEST(FilterState, KeyedRandomWalkAddsEachKindsNoise) {
   EXPECT_EQ(s.P().topLeftCorner(3, 3), P0.topLeftCorner(3, 3));
 }
 
+// A code multipath state is a first-order Gauss-Markov process: F = I but phi on its diagonal, P' = F P F^T + q on
+// its variance; the random walks of the ambiguities and the ionosphere leave it alone.
+TEST(FilterState, CodeBiasStatesAreGaussMarkovAndOutsideTheRandomWalks) {
+  FilterState s({false, false});
+  s.add({{{gps(3), 0}, 1.0, 1.0}, {StateKey::code_bias(gps(3), 0), 0.4, 1.0}, {{gps(3), -1}, 0.0, 1.0}});
+  EXPECT_TRUE(s.key_at(4).code_bias());
+  EXPECT_FALSE(s.key_at(4).ionosphere());
+  EXPECT_FALSE(s.key_at(3).code_bias());
+  EXPECT_FALSE(s.key_at(5).code_bias());
+  EXPECT_NE(StateKey::code_bias(gps(3), 0), StateKey::code_bias(gps(3), 1));
+  s.restore_values(Eigen::VectorXd::LinSpaced(s.size(), 1.0, 6.0), random_spd(s.size(), 11));
+  const Eigen::VectorXd x0 = s.x();
+  const Eigen::MatrixXd P0 = s.P();
+  const double phi = 0.9, q = 0.05;
+  s.propagate_code_biases(phi, q);
+  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.size(), s.size());
+  F(4, 4) = phi;
+  Eigen::MatrixXd expected = F * P0 * F.transpose();
+  expected(4, 4) += q;
+  EXPECT_TRUE(s.P().isApprox(expected, kTolerance));
+  EXPECT_TRUE(s.x().isApprox(F * x0, kTolerance));
+  const Eigen::MatrixXd P1 = s.P();
+  s.add_keyed_random_walk(0.5, 0.25);
+  EXPECT_DOUBLE_EQ(s.P()(4, 4), P1(4, 4));
+  EXPECT_DOUBLE_EQ(s.P()(3, 3) - P1(3, 3), 0.5);
+  EXPECT_DOUBLE_EQ(s.P()(5, 5) - P1(5, 5), 0.25);
+}
+
 }  // namespace
 }  // namespace canyon::rtk

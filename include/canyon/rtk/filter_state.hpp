@@ -7,7 +7,8 @@
 //   heading       psi (1, rad; the error of an external aiding's heading, with a heading state)
 //   scale         s (1, relative; the error of an external aiding's scale, with a scale state)
 //   keyed states  one per StateKey, in the order added: an ambiguity N_sd of (satellite, frequency rank) in cycles,
-//                 or a satellite's single-differenced ionosphere I_sd in L1-band metres (frequency kIonosphere).
+//                 a satellite's single-differenced ionosphere I_sd in L1-band metres (frequency kIonosphere), or a
+//                 signal's single-differenced code multipath error in metres (StateKey::code_bias).
 // Keyed states come and go every epoch (a satellite rises, a slip resets it); the measurement update and the ambiguity
 // resolution address them by index(key), which stays valid until the next add() or remove().
 
@@ -24,10 +25,14 @@ namespace canyon::rtk {
 /// satellite's ionosphere. Ordered by satellite, then frequency.
 struct StateKey {
   static constexpr int kIonosphere = -1;
+  static constexpr int kCodeBiasRank0 = -2;  ///< the code bias of frequency rank f has frequency kCodeBiasRank0 - f
   core::SatelliteId sat;
   int frequency = 0;
 
+  /// The key of the code multipath error of (satellite, frequency rank).
+  [[nodiscard]] static StateKey code_bias(core::SatelliteId sat, int rank) { return {sat, kCodeBiasRank0 - rank}; }
   [[nodiscard]] bool ionosphere() const { return frequency == kIonosphere; }
+  [[nodiscard]] bool code_bias() const { return frequency <= kCodeBiasRank0; }
   friend bool operator==(const StateKey& a, const StateKey& b) = default;
   // NOLINTNEXTLINE(modernize-use-nullptr): clang-tidy 14 misreads a defaulted operator<=>
   friend auto operator<=>(const StateKey& a, const StateKey& b) = default;
@@ -105,6 +110,9 @@ class FilterState {
   void add_position_increment(const Eigen::Vector3d& dp_E_m, const Eigen::Matrix3d& Q_E_m2);
   /// Adds q_ambiguity to every ambiguity's variance and q_ionosphere to every ionosphere state's.
   void add_keyed_random_walk(double q_ambiguity, double q_ionosphere);
+  /// First-order Gauss-Markov step of every code bias state: x_i <- phi x_i, its row and column of P times phi, then
+  /// q added to its variance.
+  void propagate_code_biases(double phi, double q);
   /// An aiding error state (heading_index() or scale_index()) restarted: value 0, the variance, uncorrelated.
   void restart_aiding_state(int index, double variance);
   /// Its share of the position: p += J x_i, P = F P F^T with F = I + J e_i^T, then its variance grows by `noise`.

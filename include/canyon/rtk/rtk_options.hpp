@@ -22,12 +22,17 @@ struct RtkOptions {
   ArMode ar_mode = ArMode::Continuous;
   double elevation_mask_rad = 15.0 * 0.017453292519943295;     ///< satellites below are not used
   double ar_elevation_mask_rad = 15.0 * 0.017453292519943295;  ///< ambiguities below are not fixed
-  bool dynamics = false;                      ///< constant-acceleration model; false: position from SPP each epoch
-  double accel_sigma_h_mps2 = 3.0;            ///< horizontal acceleration noise (m/s^2 per sqrt(s)) with dynamics
-  double accel_sigma_v_mps2 = 1.0;            ///< vertical acceleration noise with dynamics
-  double phase_sigma_m = 0.003;               ///< a: zenith-independent phase noise (m)
-  double phase_sigma_el_m = 0.003;            ///< b: elevation-dependent phase noise (m), divided by sin(el)
-  double code_phase_ratio = 100.0;            ///< code sigma / phase sigma
+  bool dynamics = false;            ///< constant-acceleration model; false: position from SPP each epoch
+  double accel_sigma_h_mps2 = 3.0;  ///< horizontal acceleration noise (m/s^2 per sqrt(s)) with dynamics
+  double accel_sigma_v_mps2 = 1.0;  ///< vertical acceleration noise with dynamics
+  double phase_sigma_m = 0.003;     ///< a: zenith-independent phase noise (m)
+  double phase_sigma_el_m = 0.003;  ///< b: elevation-dependent phase noise (m), divided by sin(el)
+  double code_phase_ratio = 100.0;  ///< code sigma / phase sigma
+
+  /// Time-correlated code multipath (single_difference.hpp): sigma of each signal's SD code error state (m); 0: none.
+  double code_multipath_sigma_m = 0.0;
+  double code_multipath_correlation_s = 30.0;  ///< its correlation time (s)
+
   bool snr_weighting = false;                 ///< b^2 10^((snr_reference - C/N0) / 10) instead of b^2 / sin^2(el)
   double snr_reference_dbhz = 45.0;           ///< C/N0 at which the SNR model's phase sigma is b (dB-Hz)
   double initial_ambiguity_sigma_cyc = 30.0;  ///< sigma of a new ambiguity (cycles)

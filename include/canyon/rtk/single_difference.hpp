@@ -15,6 +15,13 @@
 //   sigma_code = code_phase_ratio * sigma_phase,
 // the SD variance the sum of the two receivers'. test_variance_m2 keeps the elevation model alone, for the post-fit
 // tests (dd_update.hpp), so that weighting down a weak signal does not hide it from them.
+//
+// Time-correlated code multipath (code_multipath_sigma_m > 0): a wall beside the street gives a signal a code error
+// that lasts as long as the geometry does, which white code noise would count again at every epoch (the float
+// ambiguities it pulls are then biased with a small sigma). Each signal's SD code then has an error state m_sd
+// (metres, in the code rows only), a first-order Gauss-Markov process with sigma s and correlation time tau:
+//   m' = phi m + w,  phi = exp(-dt / tau),  var(w) = s^2 (1 - phi^2),  m starting at 0 with variance s^2;
+// so code informs the position and ambiguities once per correlation time, not once per epoch.
 
 #include <cstdint>
 #include <vector>
@@ -45,6 +52,7 @@ struct SingleDiff {
   std::uint8_t lli = 0;     ///< rover | base loss-of-lock bits
   int ambiguity = -1;       ///< state index of N_sd, -1 if none (or its phase is not used this epoch)
   int iono = -1;            ///< state index of the satellite's SD ionosphere, -1 if not estimated
+  int code_bias = -1;       ///< state index of the signal's SD code multipath error, -1 if not modelled
   double iono_scale = 1.0;  ///< (f_1 / f)^2: the delay on this frequency per metre of first-frequency delay
   bool fixable = false;     ///< its ambiguity may be fixed this epoch
 };

@@ -52,7 +52,8 @@ struct AidingLive {
 /// The external motion; `live` is read and set.
 void external_motion_update(FilterState& state, const ExternalMotion& motion, AidingLive& live);
 
-/// The random walks of the keyed states over dt_s.
+/// The random walks of the keyed states over dt_s, and the Gauss-Markov step of the code multipath states
+/// (single_difference.hpp).
 void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_s);
 
 }  // namespace canyon::rtk
