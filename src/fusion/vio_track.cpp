@@ -52,7 +52,11 @@ double median_interval_s(const std::vector<VioTrackSample>& samples) {
 }
 
 std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options,
-                          double nominal_interval_s) {
+                          double nominal_interval_s, SegmentBreak* kind) {
+  const auto set = [&](SegmentBreak k) {
+    if (kind != nullptr) *kind = k;
+  };
+  set(SegmentBreak::None);
   const double dt_s = s.t_s - prev.t_s;
   const double jump_m = (s.T_OI.p - prev.T_OI.p).norm();
   const double turn_deg = core::so3_log(prev.T_OI.q.conjugate() * s.T_OI.q).norm() * core::kRadToDeg;
@@ -61,15 +65,18 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
   char buffer[160];
   if (dt_s > std::max(options.max_gap_s, kGapIntervals * nominal_interval_s)) {
     std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s (poses %.2f s apart before it)", dt_s, nominal_interval_s);
+    set(SegmentBreak::Gap);
     return buffer;
   }
   if (jump_m > options.max_speed_mps * dt_s || turn_deg > options.max_rotation_rate_dps * dt_s) {
     std::snprintf(buffer, sizeof buffer, "VIO jump of %.2f m and %.1f deg in %.3f s (odometry frame reset)", jump_m,
                   turn_deg, dt_s);
+    set(jump_m > options.max_speed_mps * dt_s ? SegmentBreak::Jump : SegmentBreak::Turn);
     return buffer;
   }
   if (prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace) {
     std::snprintf(buffer, sizeof buffer, "VIO covariance reset (position trace %.3g -> %.3g m^2)", prev_trace, trace);
+    set(SegmentBreak::CovarianceReset);
     return buffer;
   }
   return {};
@@ -77,26 +84,70 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
 
 namespace {
 
+/// Stitches `s`, the first pose after a jump or reset, to `prev` (and `before_prev`, if of its segment, for the
+/// extrapolation): `stitch` then maps every later pose of the new frame (see the top of vio_track.hpp).
+void stitch_to(const VioTrackSample* before_prev, const VioTrackSample& prev, VioTrackSample& s,
+               const VioTrackOptions& options, FrameStitch& stitch) {
+  const double dt_s = s.t_s - prev.t_s;
+  core::Pose predicted = prev.T_OI;
+  if (before_prev != nullptr && before_prev->segment == prev.segment && prev.t_s > before_prev->t_s) {
+    predicted = core::se3_interpolate(before_prev->T_OI, prev.T_OI, 1.0 + dt_s / (prev.t_s - before_prev->t_s));
+  }
+  const core::Pose given = s.T_OI;  // s as the VIO gave it
+  const core::Matrix6d P_given = s.P;
+  stitch.F = predicted * given.inverse();
+  const double sigma_m = options.interpolation_accel_mps2 * dt_s * dt_s / 2.0;
+  core::Matrix6d Q = core::Matrix6d::Zero();
+  Q.topLeftCorner<3, 3>().diagonal().setConstant(std::max(sigma_m * sigma_m, 1e-8));
+  s.T_OI = predicted;
+  s.P = prev.P + Q;
+  s.C_previous = prev.P;
+  stitch.dP = s.P - P_given;
+  ++stitch.count;
+}
+
 /// Gives `s` its segment after `prev` (nullptr: the first sample), its interval judged against `intervals` (which
-/// it joins); the reason and the new segment in `note`.
-void place_in_segment(const VioTrackSample* prev, VioTrackSample& s, const VioTrackOptions& options,
-                      PoseIntervals& intervals, const core::GpsTime& reference, std::string* note) {
+/// it joins), in the frame `stitch` maps to; the reason and the new segment (or the stitch) in `note`.
+void place_in_segment(const VioTrackSample* before_prev, const VioTrackSample* prev, VioTrackSample& s,
+                      const VioTrackOptions& options, PoseIntervals& intervals, FrameStitch& stitch,
+                      const core::GpsTime& reference, std::string* note) {
   if (prev == nullptr) {
     s.segment = 0;
     s.C_previous.setZero();
     return;
   }
+  // The breaks are judged in the frame and covariances as the VIO gives them.
+  VioTrackSample prev_given = *prev;
+  if (stitch.count > 0) {
+    prev_given.T_OI = stitch.F.inverse() * prev->T_OI;
+    prev_given.P = prev->P - stitch.dP;
+  }
   const double dt_s = s.t_s - prev->t_s;
-  const std::string why = segment_break(*prev, s, options, intervals.nominal_s(dt_s));
+  SegmentBreak kind = SegmentBreak::None;
+  const std::string why = segment_break(prev_given, s, options, intervals.nominal_s(dt_s), &kind);
   intervals.add(dt_s);
   s.segment = prev->segment;
-  if (why.empty()) return;
+  if (why.empty()) {
+    if (stitch.count > 0) {
+      s.T_OI = stitch.F * s.T_OI;
+      s.P += stitch.dP;
+      s.C_previous += stitch.dP;
+    }
+    return;
+  }
+  const std::string where = " at " + core::format_gpst(reference + s.t_s, 3) + " (line " + std::to_string(s.line) + ")";
+  if ((kind == SegmentBreak::Jump || kind == SegmentBreak::CovarianceReset) && options.stitch_frame_resets) {
+    stitch_to(before_prev, *prev, s, options, stitch);
+    if (note != nullptr) {
+      *note = why + where + ": the new frame stitched to the old one (the device's pose taken as continuous), the " +
+              "alignment kept";
+    }
+    return;
+  }
+  stitch = FrameStitch{};  // a new segment starts in the frame as given
   s.segment = prev->segment + 1;
   s.C_previous.setZero();  // no predecessor in its segment
-  if (note != nullptr) {
-    *note = why + " at " + core::format_gpst(reference + s.t_s, 3) + " (line " + std::to_string(s.line) +
-            "): new VIO segment " + std::to_string(s.segment) + ", fusion re-aligns";
-  }
+  if (note != nullptr) *note = why + where + ": new VIO segment " + std::to_string(s.segment) + ", fusion re-aligns";
 }
 
 }  // namespace
@@ -104,9 +155,11 @@ void place_in_segment(const VioTrackSample* prev, VioTrackSample& s, const VioTr
 void assign_segments(std::vector<VioTrackSample>& samples, const VioTrackOptions& options,
                      const core::GpsTime& reference, std::vector<std::string>* notes) {
   PoseIntervals intervals;
+  FrameStitch stitch;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     std::string note;
-    place_in_segment(k == 0 ? nullptr : &samples[k - 1], samples[k], options, intervals, reference, &note);
+    place_in_segment(k < 2 ? nullptr : &samples[k - 2], k == 0 ? nullptr : &samples[k - 1], samples[k], options,
+                     intervals, stitch, reference, &note);
     if (notes != nullptr && !note.empty()) notes->push_back(note);
   }
 }
@@ -151,7 +204,9 @@ bool VioTrack::append(const io::VioRecord& record, const core::GpsTime& t, std::
   s.P = record.covariance;
   if (options_.use_cross_covariance && record.cross_previous) s.C_previous = *record.cross_previous;
   s.line = record.line;
-  place_in_segment(samples_.empty() ? nullptr : &samples_.back(), s, options_, intervals_, reference_, note);
+  const std::size_t n = samples_.size();
+  place_in_segment(n < 2 ? nullptr : &samples_[n - 2], n == 0 ? nullptr : &samples_[n - 1], s, options_, intervals_,
+                   stitch_, reference_, note);
   samples_.push_back(s);
   return true;
 }

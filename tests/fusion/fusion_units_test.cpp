@@ -229,7 +229,9 @@ TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   for (int k = 20; k < 40; ++k) s[static_cast<std::size_t>(k)].T_OI.p.x() += 100.0;  // a 100 m jump at sample 20
   for (int k = 30; k < 40; ++k) s[static_cast<std::size_t>(k)].P *= 1e-4;            // a covariance reset at 30
   const core::GpsTime ref{2266, 100.0};
-  const VioTrack track = VioTrack::from_samples(s, ref);
+  VioTrackOptions unstitched;
+  unstitched.stitch_frame_resets = false;
+  const VioTrack track = VioTrack::from_samples(s, ref, unstitched);
   EXPECT_EQ(track.segments(), 4);
   EXPECT_EQ(track.samples()[9].segment, 0);
   EXPECT_EQ(track.samples()[10].segment, 1);
@@ -245,6 +247,48 @@ TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   EXPECT_FALSE(track.pose_at(ref - 0.2).has_value());    // before the first pose beyond extrapolation_s
   EXPECT_TRUE(track.pose_at(ref - 0.02).has_value());    // within it
   EXPECT_FALSE(track.pose_at(ref + 100.0).has_value());  // after the last
+}
+
+// A jump in position or a covariance reset is a new odometry frame: stitched to the old one, the device's pose
+// continuous (extrapolated by the last increment), the increments inside the new frame with their variances; a gap and
+// a turn too fast with the position continuous still start a segment.
+TEST(VioTrackTest, StitchesJumpsAndResetsButNotGapsOrTurns) {
+  std::vector<VioTrackSample> s = straight_samples(60, 0.1, 1.4);
+  for (int k = 1; k < 60; ++k) s[static_cast<std::size_t>(k)].C_previous = s[static_cast<std::size_t>(k - 1)].P;
+  std::vector<VioTrackSample> given = s;
+  const core::Pose frame{Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())), {100.0, -20.0, 1.0}};
+  for (int k = 20; k < 60; ++k) given[static_cast<std::size_t>(k)].T_OI = frame * s[static_cast<std::size_t>(k)].T_OI;
+  for (int k = 40; k < 60; ++k) given[static_cast<std::size_t>(k)].P *= 1e-4;  // and a covariance reset at 40
+  const core::GpsTime ref{2266, 100.0};
+  const VioTrack track = VioTrack::from_samples(given, ref);
+  EXPECT_EQ(track.segments(), 1);
+  for (int k = 0; k < 60; ++k) {  // the walk comes back to within the extrapolation's 1.4 mm per stitch
+    EXPECT_LT((track.samples()[static_cast<std::size_t>(k)].T_OI.p - s[static_cast<std::size_t>(k)].T_OI.p).norm(),
+              k < 20 ? 1e-12 : 3e-3)
+        << k;
+  }
+  const auto increment_variance = [&](double ta, double tb) {
+    const auto a = track.pose_at(ref + ta), b = track.pose_at(ref + tb);
+    const Matrix12d J = track.joint_covariance(*a, *b);
+    return J(0, 0) + J(6, 6) - 2.0 * J(0, 6);
+  };
+  const double inside = increment_variance(2.5, 2.6);  // within the frame after the jump, as given
+  const VioTrack given_track =
+      VioTrack::from_samples(std::vector<VioTrackSample>(given.begin() + 20, given.end()), ref);
+  const auto a = given_track.pose_at(ref + 2.5), b = given_track.pose_at(ref + 2.6);
+  const Matrix12d J = given_track.joint_covariance(*a, *b);
+  EXPECT_NEAR(inside, J(0, 0) + J(6, 6) - 2.0 * J(0, 6), 1e-12);
+  // Across the jump: the extrapolation's error only, (q dt^2 / 2)^2 per axis.
+  EXPECT_NEAR(increment_variance(1.9, 2.0), std::pow(VioTrackOptions{}.interpolation_accel_mps2 * 0.01 / 2.0, 2),
+              1e-12);
+  // A gap, and a turn of 90 degrees in 0.1 s at one place, are segments.
+  std::vector<VioTrackSample> turned = s;
+  const core::Pose turn{Eigen::Quaterniond(Eigen::AngleAxisd(1.5, Eigen::Vector3d::UnitZ())), Eigen::Vector3d::Zero()};
+  for (int k = 20; k < 60; ++k) {
+    turned[static_cast<std::size_t>(k)].T_OI.q = turn.q * s[static_cast<std::size_t>(k)].T_OI.q;
+  }
+  for (int k = 40; k < 60; ++k) turned[static_cast<std::size_t>(k)].t_s += 1.0;
+  EXPECT_EQ(VioTrack::from_samples(turned, ref).segments(), 3);
 }
 
 TEST(CausalTimeBridgeTest, MapsWithThePairsOlderThanTheHoldOnlyAndOnlyOnceTheyAreIn) {

@@ -255,16 +255,36 @@ TEST_F(FusionBadInput, NonPositiveDefiniteCovarianceIsDroppedWithAWarning) {
   EXPECT_NE(r.output.find("vio-cov.csv:41: covariance is not positive definite"), std::string::npos) << r.output;
 }
 
-TEST_F(FusionBadInput, AJumpOf100mStartsANewSegmentThatIsAlignedAgain) {
+// A jump of the odometry frame is stitched: the track keeps its alignment and its accuracy. Without stitching it starts
+// a new segment that is aligned again.
+TEST_F(FusionBadInput, AJumpOf100mIsStitchedOrStartsANewSegment) {
   std::vector<std::string> v = lines("vio.csv");
   for (std::size_t k = 150; k < v.size(); ++k) {
     const std::size_t start = v[k].find(',') + 1;
     const double px = std::stod(v[k].substr(start, v[k].find(',', start) - start));
     v[k] = with_field(v[k], 1, std::to_string(px + 100.0));
   }
-  const auto r = fuse(write("vio-jump.csv", v), dir_ / "timesync.csv");
+  const fs::path jumped = write("vio-jump.csv", v);
+  auto r = fuse(jumped, dir_ / "timesync.csv");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("odometry frame reset"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the new frame stitched to the old one"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 VIO segment(s)"), std::string::npos) << r.output;
+  const fs::path json = dir_ / "jump.json";
+  r = canyon("evaluate -q --truth " + (dir_ / "truth.csv").string() + " --solution " + (dir_ / "x.pos").string() +
+             " --label fusion --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(json_number(read_text(json), "fusion", "wrong_fixes"), 0.0);
+  EXPECT_LE(json_number(read_text(json), "fusion", "rmse_m"), 0.05);  // 3D, all epochs: no trace of the jump
+  std::string config = read_text(fs::path(CANYON_SOURCE_DIR) / "config/fusion.yaml");
+  const std::string on = "vio_stitch_resets: true";
+  ASSERT_NE(config.find(on), std::string::npos);
+  config.replace(config.find(on), on.size(), "vio_stitch_resets: false");
+  const fs::path unstitched = write("fusion-unstitched.yaml", {config});
+  r = canyon("process --config " + unstitched.string() + " --rover " + (dir_ / "rover.obs").string() + " --base " +
+             (dir_ / "base.obs").string() + " --nav " + (dir_ / "nav.rnx").string() + " --vio " + jumped.string() +
+             " --timesync " + (dir_ / "timesync.csv").string() + " --out " + (dir_ / "y.pos").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("new VIO segment 1"), std::string::npos) << r.output;
 }
 

@@ -10,6 +10,17 @@
 // reset_covariance_ratio times the previous one's: the VIO restarted its covariance with its frame). T_EO belongs to
 // one segment; the fusion re-aligns in a new one.
 //
+// Stitching (stitch_frame_resets, beyond the paper). A jump (in position) or a covariance reset moves the VIO's
+// odometry frame, not
+// the device, whose pose is continuous over one pose interval: the poses from there on are mapped back into the
+// frame before, T_OI <- F T_OI with F = T_pred T_first^-1 (T_pred: the pose before extrapolated by its last
+// increment over the interval, T_first: the first pose in the new frame), and stay in the same segment, so the
+// alignment holds through the reset. Their covariances are shifted by one matrix dP so that the first is
+// P_before + Q (Q: the extrapolation's error, interpolation_accel_mps2 over the interval, per position axis) with
+// cov(before, first) = P_before; increments inside the new frame keep their variances (dP cancels in them). A gap
+// still starts a new segment (during a gap the device moves unseen), and so does a turn too fast with the position
+// continuous (a frame rotated about anything but the device would move the position too: the device turned).
+//
 // Interpolation at time t between samples k and k+1 of one segment, a = (t - t_k) / (t_k+1 - t_k):
 //   T(t) = T_k Exp(a Log(T_k^-1 T_k+1)),   xi(t) = J_T_Tk xi_k + J_T_Tk+1 xi_k+1   (core::se3_interpolate).
 // At most extrapolation_s beyond the first or last sample of a segment, with a outside [0, 1].
@@ -54,6 +65,7 @@ struct VioTrackOptions {
   /// acceleration, so their errors are fully correlated (an increment within an interval gets only the difference);
   /// poses in different intervals are taken as independent. 0: interpolation taken as exact.
   double interpolation_accel_mps2 = 1.0;
+  bool stitch_frame_resets = true;  ///< map a jump's or reset's new frame back into the old one (above)
 
   [[nodiscard]] std::string validate() const;
 };
@@ -72,6 +84,13 @@ class PoseIntervals {
 
  private:
   std::vector<double> recent_;  // at most kWindow, oldest first
+};
+
+/// The correction from the VIO's current odometry frame to the one it is stitched to (identity until a reset).
+struct FrameStitch {
+  core::Pose F;                                ///< T_OI (stitched) = F T_OI (as given)
+  core::Matrix6d dP = core::Matrix6d::Zero();  ///< added to each P and C_previous
+  int count = 0;                               ///< resets stitched
 };
 
 struct VioTrackSample {
@@ -143,13 +162,15 @@ class VioTrack {
   core::GpsTime reference_;
   VioTrackOptions options_;
   PoseIntervals intervals_;  // of the appended poses (streaming)
+  FrameStitch stitch_;       // of the appended poses (streaming)
   int forgotten_ = 0;        // samples forgotten from the front: samples_[0] has index forgotten_
 };
 
 /// Why `next` starts a new segment after `previous` (a gap, a jump, a covariance reset), empty if it does not; a gap
-/// is judged against max(options.max_gap_s, kGapIntervals nominal_interval_s).
+/// is judged against max(options.max_gap_s, kGapIntervals nominal_interval_s); `kind`, if given, receives which.
+enum class SegmentBreak { None, Gap, Jump, Turn, CovarianceReset };
 std::string segment_break(const VioTrackSample& previous, const VioTrackSample& next, const VioTrackOptions& options,
-                          double nominal_interval_s = 0.0);
+                          double nominal_interval_s = 0.0, SegmentBreak* kind = nullptr);
 
 /// The median interval between consecutive samples (0 with fewer than two): the stream's rate, for reports.
 [[nodiscard]] double median_interval_s(const std::vector<VioTrackSample>& samples);
