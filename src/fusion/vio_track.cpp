@@ -117,14 +117,17 @@ void place_in_segment(const VioTrackSample* before_prev, const VioTrackSample* p
     return;
   }
   // The breaks are judged in the frame and covariances as the VIO gives them.
-  VioTrackSample prev_given = *prev;
+  const VioTrackSample* judged = prev;
+  VioTrackSample prev_given;
   if (stitch.count > 0) {
+    prev_given = *prev;
     prev_given.T_OI = stitch.F.inverse() * prev->T_OI;
     prev_given.P = prev->P - stitch.dP;
+    judged = &prev_given;
   }
   const double dt_s = s.t_s - prev->t_s;
   SegmentBreak kind = SegmentBreak::None;
-  const std::string why = segment_break(prev_given, s, options, intervals.nominal_s(dt_s), &kind);
+  const std::string why = segment_break(*judged, s, options, intervals.nominal_s(dt_s), &kind);
   intervals.add(dt_s);
   s.segment = prev->segment;
   if (why.empty()) {

@@ -107,22 +107,20 @@ void FilterState::add_position_increment(const Eigen::Vector3d& dp_E_m, const Ei
   P_.topLeftCorner<3, 3>() += 0.5 * (Q_E_m2 + Q_E_m2.transpose());
 }
 
-void FilterState::add_keyed_random_walk(double q_ambiguity, double q_ionosphere) {
+void FilterState::propagate_keyed(const KeyedProcess& process) {
   const int k = num_unkeyed();
   for (Eigen::Index i = k; i < x_.size(); ++i) {
     const StateKey& key = keys_[static_cast<std::size_t>(i - k)];
-    if (!key.code_bias()) P_(i, i) += key.ionosphere() ? q_ionosphere : q_ambiguity;
-  }
-}
-
-void FilterState::propagate_code_biases(double phi, double q) {
-  const int k = num_unkeyed();
-  for (Eigen::Index i = k; i < x_.size(); ++i) {
-    if (!keys_[static_cast<std::size_t>(i - k)].code_bias()) continue;
-    x_[i] *= phi;
-    P_.row(i) *= phi;
-    P_.col(i) *= phi;
-    P_(i, i) += q;
+    if (!key.code_bias()) {
+      P_(i, i) += key.ionosphere() ? process.q_ionosphere : process.q_ambiguity;
+      continue;
+    }
+    if (process.phi_code != 1.0) {
+      x_[i] *= process.phi_code;
+      P_.row(i) *= process.phi_code;
+      P_.col(i) *= process.phi_code;
+    }
+    P_(i, i) += process.q_code;
   }
 }
 

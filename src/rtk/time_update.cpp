@@ -55,14 +55,15 @@ void external_motion_update(FilterState& state, const ExternalMotion& motion, Ai
 }
 
 void keyed_random_walk(FilterState& state, const RtkOptions& options, double dt_s) {
-  const double q_amb = options.ambiguity_noise_cyc * options.ambiguity_noise_cyc * dt_s;
-  const double q_iono = options.iono_noise_m * options.iono_noise_m * dt_s;
-  state.add_keyed_random_walk(q_amb, q_iono);
+  FilterState::KeyedProcess process;
+  process.q_ambiguity = options.ambiguity_noise_cyc * options.ambiguity_noise_cyc * dt_s;
+  process.q_ionosphere = options.iono_noise_m * options.iono_noise_m * dt_s;
   if (options.code_multipath_sigma_m > 0.0) {
-    const double phi = std::exp(-dt_s / options.code_multipath_correlation_s);
+    process.phi_code = std::exp(-dt_s / options.code_multipath_correlation_s);
     const double s2 = options.code_multipath_sigma_m * options.code_multipath_sigma_m;
-    state.propagate_code_biases(phi, s2 * (1.0 - phi * phi));
+    process.q_code = s2 * (1.0 - process.phi_code * process.phi_code);
   }
+  state.propagate_keyed(process);
 }
 
 }  // namespace canyon::rtk

@@ -174,7 +174,7 @@ TEST(FilterState, RevertGoesBackToTheSnapshotAndSetPositionDecorrelates) {
   FilterState s = filled_state({false, false}, 6);
   const FilterState::Snapshot snapshot = s.snapshot();
   s.add_position_increment(Eigen::Vector3d(1, 1, 1), Eigen::Matrix3d::Identity());
-  s.add_keyed_random_walk(0.5, 0.25);
+  s.propagate_keyed({0.5, 0.25});
   s.revert(snapshot);
   EXPECT_EQ(s.x(), snapshot.x);
   EXPECT_EQ(s.P(), snapshot.P);
@@ -186,7 +186,7 @@ TEST(FilterState, RevertGoesBackToTheSnapshotAndSetPositionDecorrelates) {
 TEST(FilterState, KeyedRandomWalkAddsEachKindsNoise) {
   FilterState s = filled_state({false, false}, 7);
   const Eigen::MatrixXd P0 = s.P();
-  s.add_keyed_random_walk(0.5, 0.25);
+  s.propagate_keyed({0.5, 0.25});
   for (int i = 3; i < s.size(); ++i) {
     EXPECT_DOUBLE_EQ(s.P()(i, i) - P0(i, i), s.key_at(i).ionosphere() ? 0.25 : 0.5) << i;
   }
@@ -207,7 +207,7 @@ TEST(FilterState, CodeBiasStatesAreGaussMarkovAndOutsideTheRandomWalks) {
   const Eigen::VectorXd x0 = s.x();
   const Eigen::MatrixXd P0 = s.P();
   const double phi = 0.9, q = 0.05;
-  s.propagate_code_biases(phi, q);
+  s.propagate_keyed({0.0, 0.0, phi, q});
   Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.size(), s.size());
   F(4, 4) = phi;
   Eigen::MatrixXd expected = F * P0 * F.transpose();
@@ -215,7 +215,7 @@ TEST(FilterState, CodeBiasStatesAreGaussMarkovAndOutsideTheRandomWalks) {
   EXPECT_TRUE(s.P().isApprox(expected, kTolerance));
   EXPECT_TRUE(s.x().isApprox(F * x0, kTolerance));
   const Eigen::MatrixXd P1 = s.P();
-  s.add_keyed_random_walk(0.5, 0.25);
+  s.propagate_keyed({0.5, 0.25});
   EXPECT_DOUBLE_EQ(s.P()(4, 4), P1(4, 4));
   EXPECT_DOUBLE_EQ(s.P()(3, 3) - P1(3, 3), 0.5);
   EXPECT_DOUBLE_EQ(s.P()(5, 5) - P1(5, 5), 0.25);

@@ -108,11 +108,15 @@ class FilterState {
   /// An external motion as the model: p += dp, P_pp += sym(Q); the position's correlations with the other states
   /// are kept (dp does not depend on x).
   void add_position_increment(const Eigen::Vector3d& dp_E_m, const Eigen::Matrix3d& Q_E_m2);
-  /// Adds q_ambiguity to every ambiguity's variance and q_ionosphere to every ionosphere state's.
-  void add_keyed_random_walk(double q_ambiguity, double q_ionosphere);
-  /// First-order Gauss-Markov step of every code bias state: x_i <- phi x_i, its row and column of P times phi, then
-  /// q added to its variance.
-  void propagate_code_biases(double phi, double q);
+  /// The keyed states' process over one interval, per kind: a first-order Gauss-Markov step x_i <- phi x_i (its row
+  /// and column of P times phi), then q added to its variance; phi = 1 is a random walk.
+  struct KeyedProcess {
+    double q_ambiguity = 0.0;   ///< ambiguities: random walk
+    double q_ionosphere = 0.0;  ///< ionosphere states: random walk
+    double phi_code = 1.0;      ///< code multipath states
+    double q_code = 0.0;
+  };
+  void propagate_keyed(const KeyedProcess& process);
   /// An aiding error state (heading_index() or scale_index()) restarted: value 0, the variance, uncorrelated.
   void restart_aiding_state(int index, double variance);
   /// Its share of the position: p += J x_i, P = F P F^T with F = I + J e_i^T, then its variance grows by `noise`.
