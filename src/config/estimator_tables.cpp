@@ -104,6 +104,10 @@ Table<O> rtk_model_keys() {
        at(&O::iono_sigma_per_10km_m)},
       {"iono_sigma_min_m", "m", "... and at least this, whatever the baseline", at(&O::iono_sigma_min_m)},
       {"iono_noise_m", "m per sqrt(s)", "ionosphere random walk", at(&O::iono_noise_m)},
+      {"iono_residual_sigma_per_10km_m", "m",
+       "a new ionosphere state from the others' (their mapped vertical delay) plus a residual of this vertical sigma "
+       "per 10 km of baseline; 0: independent states with iono_sigma_per_10km_m",
+       at(&O::iono_residual_sigma_per_10km_m)},
   };
 }
 

@@ -16,8 +16,7 @@ std::vector<StateKey> AmbiguityStates::stale(const core::GpsTime& t, double max_
 
 std::vector<FilterState::NewState> AmbiguityStates::admit(std::vector<SingleDiff>& sds, const FilterState& state,
                                                           const core::GpsTime& t, const SlipScan& slips,
-                                                          const RtkOptions& options,
-                                                          std::optional<double> iono_sigma_m) {
+                                                          const RtkOptions& options, bool iono_estimated) {
   // New states are collected and appended at once (in the order found, as one by one).
   std::vector<FilterState::NewState> new_states;
   const auto has_state = [&](const StateKey& key) {
@@ -50,12 +49,8 @@ std::vector<FilterState::NewState> AmbiguityStates::admit(std::vector<SingleDiff
       info_[key].last_seen = t;
     }
   }
-  if (iono_sigma_m) {
-    for (const SingleDiff& sd : sds) {
-      const StateKey key{sd.sat, StateKey::kIonosphere};
-      if (!has_state(key)) new_states.push_back(FilterState::NewState{key, 0.0, *iono_sigma_m * *iono_sigma_m});
-      info_[key].last_seen = t;
-    }
+  if (iono_estimated) {
+    for (const SingleDiff& sd : sds) info_[StateKey{sd.sat, StateKey::kIonosphere}].last_seen = t;
   }
   return new_states;
 }

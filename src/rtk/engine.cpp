@@ -6,6 +6,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "canyon/rtk/ionosphere_prior.hpp"
+
 namespace canyon::rtk {
 
 /// The epoch between the stages (predict, update, resolve).
@@ -129,12 +131,13 @@ void RtkEngine::predict_states(const core::ObsEpoch& rover, EpochGeometry& geome
 void RtkEngine::track_states(std::vector<SingleDiff>& sds, const core::GpsTime& t, const SlipScan& slips) {
   for (const SlipEvent& e : slips.events) remove_state({e.sat, e.frequency});
   for (const StateKey& key : states_.stale(t, options_.max_outage_s)) remove_state(key);
-  std::optional<double> iono_sigma_m;
+  state_.add(states_.admit(sds, state_, t, slips, options_, iono_estimated_));
   if (iono_estimated_) {
     const double baseline_10km = (state_.position_E_m() - p_E_base_m_).norm() / 1e4;
-    iono_sigma_m = std::max(options_.iono_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m);
+    const IonospherePrior prior{std::max(options_.iono_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m),
+                                options_.iono_residual_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m};
+    add_ionosphere_states(state_, sds, prior, eph_);
   }
-  state_.add(states_.admit(sds, state_, t, slips, options_, iono_sigma_m));
   assign_state_indices(sds, state_);
 }
 

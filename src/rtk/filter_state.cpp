@@ -43,6 +43,23 @@ void FilterState::add(const std::vector<NewState>& states) {
   P_.swap(P);
 }
 
+void FilterState::add_combination(const StateKey& key, const std::vector<Term>& terms, double residual_variance) {
+  const Eigen::Index n = x_.size();
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
+  for (const Term& t : terms) {
+    assert(t.index >= 0 && t.index < n);
+    w[t.index] += t.weight;
+  }
+  const Eigen::VectorXd Pw = P_ * w;
+  x_.conservativeResize(n + 1);
+  x_[n] = w.dot(x_.head(n));
+  P_.conservativeResize(n + 1, n + 1);
+  P_.topRightCorner(n, 1) = Pw;
+  P_.bottomLeftCorner(1, n) = Pw.transpose();
+  P_(n, n) = w.dot(Pw) + residual_variance;
+  keys_.push_back(key);
+}
+
 void FilterState::remove(const StateKey& key) {
   const int index = this->index(key);
   if (index < 0) return;

@@ -44,6 +44,9 @@ std::string RtkOptions::validate() const {
   if (!(max_partial_fix_sigma_m > 0.0)) return "max_partial_fix_sigma_m must be > 0";
   if (!(snr_reference_dbhz > 0.0)) return "snr_reference_dbhz must be > 0";
   if (!(iono_auto_baseline_km >= 0.0)) return "iono_auto_baseline_km must be >= 0";
+  if (!(iono_residual_sigma_per_10km_m >= 0.0 && std::isfinite(iono_residual_sigma_per_10km_m))) {
+    return "iono_residual_sigma_per_10km_m must be finite and >= 0 (0: independent ionosphere states)";
+  }
   if (max_pruned_satellites < 0) return "max_pruned_satellites must be >= 0";
   if (!(phase_sigma_m > 0.0) || !(code_phase_ratio > 0.0)) return "phase_sigma_m and code_phase_ratio must be > 0";
   if (!(code_multipath_sigma_m >= 0.0 && std::isfinite(code_multipath_sigma_m))) {

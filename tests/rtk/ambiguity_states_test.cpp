@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "canyon/rtk/ionosphere_prior.hpp"
+
 #include "synthetic_epoch.hpp"
 
 namespace canyon::rtk {
@@ -26,13 +28,13 @@ TEST(AmbiguityStates, NewAmbiguitiesStartFromTheCodeAndBecomeFixableAfterTheirLo
   e.sds[1].lli = core::kLliHalfCycle;
   AmbiguityStates book;
   const SlipScan no_slips;
-  const auto added = book.admit(e.sds, state, at(100.0), no_slips, o, std::nullopt);
+  const auto added = book.admit(e.sds, state, at(100.0), no_slips, o, false);
   ASSERT_EQ(added.size(), 4U);
   EXPECT_NEAR(added[2].value, e.integers[2], 1e-9);  // (phase - code) / lambda at zero range
   EXPECT_DOUBLE_EQ(added[2].variance, o.initial_ambiguity_sigma_cyc * o.initial_ambiguity_sigma_cyc);
   state.add(added);
   for (int epoch = 1; epoch <= 3; ++epoch) {
-    EXPECT_TRUE(book.admit(e.sds, state, at(100.0 + epoch), no_slips, o, std::nullopt).empty());
+    EXPECT_TRUE(book.admit(e.sds, state, at(100.0 + epoch), no_slips, o, false).empty());
     EXPECT_EQ(e.sds[0].fixable, epoch >= 2) << epoch;  // tracked for more than 2 epochs
   }
   EXPECT_FALSE(e.sds[1].fixable);  // half cycle
@@ -42,7 +44,7 @@ TEST(AmbiguityStates, NewAmbiguitiesStartFromTheCodeAndBecomeFixableAfterTheirLo
   EXPECT_EQ(e.sds[2].iono, -1);
   // GLONASS without glonass_ar is never fixable.
   e.sds[0].sat.system = core::Constellation::Glonass;
-  (void)book.admit(e.sds, state, at(104.0), no_slips, o, std::nullopt);
+  (void)book.admit(e.sds, state, at(104.0), no_slips, o, false);
   EXPECT_FALSE(e.sds[0].fixable);
 }
 
@@ -52,13 +54,17 @@ TEST(AmbiguityStates, StaleAfterAnOutageAndIonosphereStatesWithTheirPrior) {
   FilterState state({false, false});
   AmbiguityStates book;
   const SlipScan no_slips;
-  const auto added = book.admit(e.sds, state, at(10.0), no_slips, RtkOptions{}, 0.05);
-  ASSERT_EQ(added.size(), 6U);  // three ambiguities, then three ionosphere states
-  EXPECT_TRUE(added[3].key.ionosphere());
-  EXPECT_DOUBLE_EQ(added[3].variance, 0.05 * 0.05);
+  const auto added = book.admit(e.sds, state, at(10.0), no_slips, RtkOptions{}, true);
+  ASSERT_EQ(added.size(), 3U);  // three ambiguities; the ionosphere states are the caller's
   state.add(added);
+  const gnss::EphemerisStore no_ephemerides{core::NavigationData{}};
+  add_ionosphere_states(state, e.sds, IonospherePrior{0.05, 0.0, 0.001}, no_ephemerides);
+  ASSERT_EQ(state.keys().size(), 6U);
+  const int iono = state.index({e.sds[0].sat, StateKey::kIonosphere});
+  ASSERT_GE(iono, 0);
+  EXPECT_DOUBLE_EQ(state.P()(iono, iono), 0.05 * 0.05);
   EXPECT_TRUE(book.stale(at(14.0), 5.0).empty());
-  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 6U);
+  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 6U);  // the ionosphere states marked seen as well
   book.forget(added[0].key);
   EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 5U);
 }
@@ -71,7 +77,7 @@ TEST(AmbiguityStates, CodeMultipathStatesComeWithEachSignalsCodeAndTheirSigma) {
   RtkOptions o;
   o.code_multipath_sigma_m = 0.7;
   AmbiguityStates book;
-  const auto added = book.admit(e.sds, state, at(10.0), SlipScan{}, o, std::nullopt);
+  const auto added = book.admit(e.sds, state, at(10.0), SlipScan{}, o, false);
   ASSERT_EQ(added.size(), 4U);  // two ambiguities, then two code states
   for (std::size_t k = 2; k < 4; ++k) {
     EXPECT_EQ(added[k].key, StateKey::code_bias(e.sds[k - 2].sat, e.sds[k - 2].frequency));

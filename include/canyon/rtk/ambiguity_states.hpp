@@ -3,8 +3,8 @@
 // receivers track its (satellite, frequency) with phase and code, reset on a cycle slip at either receiver (the
 // caller removes it), removed after an outage longer than max_outage_s, and may be fixed once it has been tracked for
 // more than min_lock_epochs, above the AR elevation mask, without an unresolved half cycle (and, for GLONASS, with
-// glonass_ar). A satellite's ionosphere state (when estimated) is added with a prior sigma that grows with the
-// baseline.
+// glonass_ar). A satellite's ionosphere state (when estimated) is added by the caller (ionosphere_prior.hpp) and
+// removed after the same outage.
 
 #include <map>
 #include <optional>
@@ -25,12 +25,13 @@ class AmbiguityStates {
   /// A state left the filter.
   void forget(const StateKey& key) { info_.erase(key); }
   void clear() { info_.clear(); }
-  /// The states to add for the epoch's single differences that `state` does not hold yet (ambiguities, in SD order,
-  /// then ionosphere states with prior sigma `iono_sigma_m` when estimated), with the epoch counted for every
-  /// ambiguity and SingleDiff::fixable set.
+  /// The states to add for the epoch's single differences that `state` does not hold yet (ambiguities in SD order,
+  /// then code multipath states), with the epoch counted for every ambiguity and SingleDiff::fixable set; with
+  /// `iono_estimated` the satellites' ionosphere states are marked seen (the caller adds the missing ones:
+  /// ionosphere_prior.hpp).
   [[nodiscard]] std::vector<FilterState::NewState> admit(std::vector<SingleDiff>& sds, const FilterState& state,
                                                          const core::GpsTime& t, const SlipScan& slips,
-                                                         const RtkOptions& options, std::optional<double> iono_sigma_m);
+                                                         const RtkOptions& options, bool iono_estimated);
 
  private:
   struct Info {

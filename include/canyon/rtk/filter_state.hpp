@@ -83,6 +83,15 @@ class FilterState {
   };
   /// Appends the states in order (one resize of x and P for all of them).
   void add(const std::vector<NewState>& states);
+  /// One term of a linear combination of held states: weight times the state at index.
+  struct Term {
+    int index = 0;
+    double weight = 0.0;
+  };
+  /// Appends a keyed state that is a linear combination of held states plus an independent residual:
+  /// x_new = sum w_i x_i + r, var(r) = residual_variance; its covariances with every state follow (P_new,* = sum w_i
+  /// P_i,*), so what the held states learn later moves it as well.
+  void add_combination(const StateKey& key, const std::vector<Term>& terms, double residual_variance);
   /// Removes a keyed state (no-op if absent).
   void remove(const StateKey& key);
   /// Removes every keyed state.

@@ -64,7 +64,10 @@ struct RtkOptions {
   double iono_sigma_per_10km_m = 0.03;  ///< prior sigma of a SD ionosphere state per 10 km of baseline (m)
   double iono_sigma_min_m = 0.001;      ///< the prior sigma is at least this (m), whatever the baseline
   double iono_noise_m = 0.001;          ///< SD ionosphere random walk (m per sqrt(s))
-  gnss::SppOptions spp;                 ///< single-point solution (prior and fallback)
+  /// A new ionosphere state from the others' (ionosphere_prior.hpp): its own vertical residual sigma per 10 km of
+  /// baseline (m); 0: every state independent, with the sigma above.
+  double iono_residual_sigma_per_10km_m = 0.0;
+  gnss::SppOptions spp;  ///< single-point solution (prior and fallback)
   /// A heading-error state of the external aiding (see above); set by the aiding's owner (the fusion), not in YAML.
   bool aiding_heading_state = false;
   /// A scale-error state of the external aiding (time_update.hpp); set by the aiding's owner, not in YAML.
