@@ -117,20 +117,35 @@ void check_post_fit(const std::vector<SingleDiff>& sds, const RtkOptions& option
 }
 
 /// The rows the gates let through; the satellites of the others are appended to `rejected`, and a refused phase
-/// row's ambiguity is not fixed this epoch.
+/// row's ambiguity is not fixed this epoch. With an injected gate, a phase row whose prediction cannot test it (a new
+/// or re-initialised ambiguity: predicted sigma beyond one cycle) takes the verdict of its signal's code row: a
+/// reflected signal whose code the gate refuses would otherwise start its ambiguity from a phase carrying the same
+/// extra path (tens of metres in a street canyon), and hold it.
 std::vector<DdRow> gated_rows(const FilterState& state, std::vector<SingleDiff>& sds, const RtkOptions& options,
                               const InnovationGate* gate, std::vector<core::SatelliteId>& rejected) {
   std::vector<DdRow> rows = dd_rows(state, sds);
+  std::vector<char> passes(rows.size(), 0);
+  std::vector<char> untestable(rows.size(), 0);
+  std::vector<char> code_refused(sds.size(), 0);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const DdRow& row = rows[k];
+    const double limit_m = row.phase ? options.max_phase_innovation_m : options.max_code_innovation_m;
+    bool pass = !(std::abs(row.innovation_m) > limit_m);
+    if (pass && gate != nullptr) {
+      const double r = sd_variance(sds, row.phase, row.sd) + sd_variance(sds, row.phase, row.reference);
+      const DdInnovation innovation(row, state.P(), r);
+      pass = gate->passes(innovation);
+      const double wavelength_m = sds[static_cast<std::size_t>(row.sd)].wavelength_m;
+      untestable[k] = row.phase && innovation.predicted_variance_m2() > wavelength_m * wavelength_m ? 1 : 0;
+      if (!pass && !row.phase) code_refused[static_cast<std::size_t>(row.sd)] = 1;
+    }
+    passes[k] = pass ? 1 : 0;
+  }
   std::vector<DdRow> kept;
   kept.reserve(rows.size());
-  for (DdRow& row : rows) {
-    const double limit_m = row.phase ? options.max_phase_innovation_m : options.max_code_innovation_m;
-    bool passes = !(std::abs(row.innovation_m) > limit_m);
-    if (passes && gate != nullptr) {
-      const double r = sd_variance(sds, row.phase, row.sd) + sd_variance(sds, row.phase, row.reference);
-      passes = gate->passes(DdInnovation(row, state.P(), r));
-    }
-    if (passes) {
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    DdRow& row = rows[k];
+    if (passes[k] != 0 && !(untestable[k] != 0 && code_refused[static_cast<std::size_t>(row.sd)] != 0)) {
       kept.push_back(row);
       continue;
     }

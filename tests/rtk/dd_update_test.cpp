@@ -1,6 +1,7 @@
 // The DD measurement update (rtk/dd_update.hpp) on a synthetic epoch (synthetic_epoch.hpp): the rows against the
 // highest satellite, the update that brings the prior to the truth, the post-fit rejection of a code outlier, the
-// fixed innovation limits and an injected gate, and float validation when more outliers remain than may be rejected.
+// fixed innovation limits and an injected gate (a phase its prediction cannot test taking its code's verdict), and
+// float validation when more outliers remain than may be rejected.
 
 #include "canyon/rtk/dd_update.hpp"
 
@@ -134,6 +135,41 @@ TEST(DdUpdate, FixedLimitsAndAnInjectedGateDropRowsAndTheirAmbiguitiesAreNotFixe
   EXPECT_EQ(f.state.x(), x0);
   EXPECT_TRUE(
       std::none_of(f.sds.begin(), f.sds.end(), [](const SingleDiff& sd) { return sd.fixable && sd.sat.prn > 1; }));
+}
+
+TEST(DdUpdate, APhaseItsPredictionCannotTestTakesTheVerdictOfItsCode) {
+  // A reflected signal: code and phase both carry 30 m of extra path. The gate refuses the code; the phase of a new
+  // ambiguity (sigma 30 cycles) tells the gate nothing and must not start that ambiguity from the reflection.
+  struct RefuseFarCode final : InnovationGate {
+    [[nodiscard]] bool passes(const DdInnovation& row) const override {
+      return row.phase() || std::abs(row.innovation_m()) < 5.0;
+    }
+  } gate;
+  const auto reflected_epoch = [](double ambiguity_var_cyc2, double phase_extra_m) {
+    testing::SyntheticEpoch e = synthetic_epoch(8, Eigen::Vector3d::Zero(), 1e-4, 0.01,
+                                                [](int /*i*/, int integer) { return static_cast<double>(integer); });
+    Eigen::MatrixXd P = e.state.P();
+    P(e.sds[4].ambiguity, e.sds[4].ambiguity) = ambiguity_var_cyc2;
+    e.state.restore_values(e.state.x(), P);
+    e.sds[4].code_m += 30.0;
+    e.sds[4].phase_m += phase_extra_m;
+    return e;
+  };
+  testing::SyntheticEpoch fresh = reflected_epoch(900.0, 30.0);
+  std::vector<core::SatelliteId> rejected;
+  const DdUpdateResult r = dd_measurement_update(fresh.state, fresh.sds, RtkOptions{}, &gate, rejected);
+  EXPECT_EQ(r.phase_rows, 6);
+  EXPECT_EQ(r.code_rows, 6);
+  EXPECT_EQ(std::count(rejected.begin(), rejected.end(), fresh.sds[4].sat), 2);  // its code and its phase
+  EXPECT_FALSE(fresh.sds[4].fixable);
+  // Code multipath on a signal whose ambiguity is known to a tenth of a cycle: its phase is tested by its own
+  // prediction and kept.
+  testing::SyntheticEpoch known = reflected_epoch(0.01, 0.0);
+  rejected.clear();
+  const DdUpdateResult k = dd_measurement_update(known.state, known.sds, RtkOptions{}, &gate, rejected);
+  EXPECT_EQ(std::count(rejected.begin(), rejected.end(), known.sds[4].sat), 1);  // its code only
+  EXPECT_EQ(k.phase_rows, 7);
+  EXPECT_TRUE(known.sds[4].fixable);
 }
 
 }  // namespace

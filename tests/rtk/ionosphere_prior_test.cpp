@@ -64,7 +64,7 @@ TEST(IonospherePrior, ANewSatelliteStartsFromTheVerticalDelayTheOthersMeasured) 
   const double k_new = ionosphere_obliquity(e.sds[4].elevation_rad);
   EXPECT_NEAR(state.x()[fresh], k_new * kVerticalM, 1e-12);
   const double sigma = std::sqrt(state.P()(fresh, fresh));
-  EXPECT_GT(sigma, k_new * 0.01);         // at least its own residual
+  EXPECT_GT(sigma, k_new * 0.01);          // at least its own residual
   EXPECT_LT(sigma, k_new * 0.01 + 0.002);  // and little of the others' uncertainty
   // Without a residual sigma the states stay independent, as before.
   FilterState plain = testing::synthetic_epoch(2, Eigen::Vector3d::Zero(), 1.0, 1.0, [](int, int n) {

@@ -12,8 +12,10 @@
 // code and phase rows are not, so the update is two sequential ones (code, then phase: kalman.hpp).
 //
 // Gates: a DD innovation beyond max_phase_innovation_m / max_code_innovation_m is not used; an injected
-// InnovationGate (the fusion's VIO gates) may refuse more rows. A refused phase row's ambiguity is not fixed that
-// epoch (its value is the prior's, not this epoch's).
+// InnovationGate (the fusion's VIO gates) may refuse more rows; a phase row that its prediction cannot test (predicted
+// sigma beyond one cycle: a new or re-initialised ambiguity) then takes the verdict of its signal's code row, so a
+// reflected signal whose code the gate refuses does not start its ambiguity from a phase with the same extra path. A
+// refused phase row's ambiguity is not fixed that epoch (its value is the prior's, not this epoch's).
 // Post-fit: after the update, the DD phase or code whose post-fit residual exceeds its threshold (max_post_fit_sigmas
 // for phase, max_post_fit_code_sigmas for code, in sigmas of the elevation model) by the largest factor is dropped for
 // the epoch and the update redone from the prior, at most max_post_fit_rejections times. A code outlier (an NLOS
