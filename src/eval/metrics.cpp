@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <numeric>
 
+#include <Eigen/Cholesky>
+
 #include "canyon/core/geodesy.hpp"
 #include "canyon/io/pos_file.hpp"
 
@@ -118,6 +120,18 @@ void append_error_columns(std::string& out, const ErrorStats& e) {
                 e.max_3d_m, e.p95_3d_m);
 }
 
+/// Counts the solution in SolutionStats::epochs_with_covariance and, when e^T C^-1 e > 9, beyond_3_sigma_horizontal.
+void count_beyond_3_sigma(const core::Solution& s, const Eigen::Vector3d& p_E_truth_m, const Eigen::Vector3d& d_N_m,
+                          SolutionStats& stats) {
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_E_truth_m));
+  const Eigen::Matrix2d C = (R_NE * s.P_E_m2 * R_NE.transpose()).topLeftCorner<2, 2>();
+  const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (C + C.transpose()));
+  if (!C.allFinite() || llt.info() != Eigen::Success) return;
+  ++stats.epochs_with_covariance;
+  const Eigen::Vector2d e = d_N_m.head<2>();
+  if (e.dot(llt.solve(e)) > 9.0) ++stats.beyond_3_sigma_horizontal;
+}
+
 }  // namespace
 
 std::string EvalOptions::validate() const {
@@ -180,6 +194,7 @@ Result<SolutionStats> evaluate(const std::vector<core::Solution>& solutions, con
     class_errors[static_cast<std::size_t>(c)].add(d_N_m);
     overall_errors.add(d_N_m);
     if (c == StatusClass::Fixed && d_N_m.norm() > options.wrong_fix_threshold_m) ++stats.wrong_fixes;
+    count_beyond_3_sigma(s, *p_E_truth_m, d_N_m, stats);
   }
   for (std::size_t k = 0; k < kNumStatusClasses; ++k) {
     StatusStats& st = stats.by_class[k];

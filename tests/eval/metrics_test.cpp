@@ -135,6 +135,27 @@ TEST(Evaluate, WrongFixesAboveTheThreshold) {
   EXPECT_EQ(loose->wrong_fixes, 1);
 }
 
+TEST(Evaluate, HorizontalErrorsBeyondThreeSigmaOfTheirOwnCovariance) {
+  // sigma 0.1 m east, 0.01 m north (ECEF covariance from ENU): 0.25 m east is 2.5 sigma, 0.05 m north 5 sigma.
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(kOrigin);
+  const Eigen::Matrix3d P_N = Eigen::Vector3d(0.01, 1e-4, 0.04).asDiagonal();
+  const auto with_sigma = [&](core::Solution s) {
+    s.P_E_m2 = R_NE.transpose() * P_N * R_NE;
+    return s;
+  };
+  std::vector<core::Solution> set = {
+      // 2.5 sigma: within (the 0.5 m up is not horizontal)
+      with_sigma(at_enu(0, SolutionStatus::Fixed, {0.25, 0.0, 0.5})),
+      with_sigma(at_enu(1, SolutionStatus::Float, {0.0, 0.05, 0.0})),  // 5 sigma: beyond
+      with_sigma(at_enu(2, SolutionStatus::Float, {0.0, 0.0, 0.0})),
+      at_enu(3, SolutionStatus::Single, {5.0, 0.0, 0.0}),  // no covariance: not judged
+  };
+  const auto stats = evaluate(set, Truth::constant(core::geodetic_to_ecef(kOrigin)));
+  ASSERT_TRUE(stats.ok());
+  EXPECT_EQ(stats->epochs_with_covariance, 3);
+  EXPECT_EQ(stats->beyond_3_sigma_horizontal, 1);
+}
+
 TEST(Evaluate, TimeToFirstFix) {
   const auto stats = evaluate(mixed_set(), nullptr);
   ASSERT_TRUE(stats.ok());

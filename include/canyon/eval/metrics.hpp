@@ -79,6 +79,10 @@ struct SolutionStats {
   std::array<StatusStats, kNumStatusClasses> by_class{};
   ErrorStats overall;   ///< all solutions with truth, every status
   int wrong_fixes = 0;  ///< fixed epochs with 3D error > wrong_fix_threshold_m
+  /// Covariance honesty: of the solutions with truth and a positive definite horizontal covariance C (east, north),
+  /// those whose horizontal error e lies beyond 3 sigma, e^T C^-1 e > 9 (a Gaussian error: 1.1 % of epochs).
+  int epochs_with_covariance = 0;
+  int beyond_3_sigma_horizontal = 0;
   double wrong_fix_threshold_m = 0.0;
   std::optional<double> time_to_first_fix_s;  ///< from the first epoch to the first fixed solution
   bool has_truth = false;
