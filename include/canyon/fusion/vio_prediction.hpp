@@ -42,7 +42,7 @@ struct PredictionOptions {
   /// Beyond the paper: the VIO's scale error (not in its covariance) as a filter state s, p += dp (1 + s), learnt
   /// from the DD phases (rtk::ExternalMotion); it starts at 0 with vio_scale_sigma on each new VIO segment and walks
   /// by vio_scale_random_walk_per_sqrt_km.
-  bool scale_state = false;
+  bool scale_state = true;
   double vio_scale_sigma = 0.01;                     ///< (relative, 1 sigma)
   double vio_scale_random_walk_per_sqrt_km = 0.001;  ///< (relative per sqrt(km) walked)
 };
