@@ -7,7 +7,6 @@
 // removed after the same outage.
 
 #include <map>
-#include <optional>
 #include <vector>
 
 #include "canyon/core/time.hpp"
