@@ -246,6 +246,11 @@ Table<F> update_keys() {
        at(&F::recovery, &R::gate_conflict_epochs)},
       {"reanchor_sigma_m", "m", "... by this sigma per axis", at(&F::recovery, &R::reanchor_sigma_m)},
       {"vio_keep_s", "s", "VIO poses older than this before the epoch are forgotten", at(&F::vio_keep_s)},
+      {"output_sigma_floor_h_m", "m",
+       "beyond the paper: the output covariance is the filter's plus this horizontal sigma (unmodelled multipath)",
+       at(&F::output_floor, &fusion::OutputFloorOptions::horizontal_sigma_m)},
+      {"output_sigma_floor_v_m", "m", "... and this vertical sigma",
+       at(&F::output_floor, &fusion::OutputFloorOptions::vertical_sigma_m)},
   };
 }
 

@@ -11,6 +11,7 @@
 #include "canyon/fusion/constant_velocity.hpp"
 #include "canyon/fusion/float_validation.hpp"
 #include "canyon/fusion/heading_state.hpp"
+#include "canyon/fusion/output_floor.hpp"
 #include "canyon/fusion/vio_fill_in.hpp"
 
 namespace canyon::fusion {
@@ -211,7 +212,12 @@ void FusionEngine::count_fix_refusals() {
 // ---- Lines 8, 11, 16, 18, 22, 24: validation and the output ----
 
 FusionEpoch FusionEngine::finish_epoch() {
-  if (heading_free_epoch_) return finish_heading_free();
+  FusionEpoch out = heading_free_epoch_ ? finish_heading_free() : finish_solved_epoch();
+  add_output_floor(out.solution, options_.output_floor);  // the output's covariance only (output_floor.hpp)
+  return out;
+}
+
+FusionEpoch FusionEngine::finish_solved_epoch() {
   const rtk::RtkEpoch epoch = engine_.take_epoch();
   count_fix_refusals();
   FusionEpoch out;

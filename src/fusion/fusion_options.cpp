@@ -9,7 +9,7 @@ std::string FusionOptions::validate() const {
   if (const std::string e = vio.validate(); !e.empty()) return "vio: " + e;
   for (const std::string& e :
        {alignment.validate(), cn0.validate(), coarse.validate(), integrity.validate(), heading.validate(),
-        gates.validate(), recovery.validate(), guard.validate(), validation.validate()}) {
+        gates.validate(), recovery.validate(), guard.validate(), validation.validate(), output_floor.validate()}) {
     if (!e.empty()) return e;
   }
   if (!(prediction.constant_increment_sigma_m > 0.0)) return "constant_increment_sigma_m must be > 0";

@@ -1,6 +1,7 @@
 // The fusion's pieces one by one, each against its model: the prior of Eqs. 3-6 (predict_with_vio), the innovation
 // gates (line 6), float validation (line 8), the fill-in (line 22), the false-fix guard, the prior recovery, the
-// integrity check, the heading state, the heading-free fill-in and the constant-velocity ablation.
+// integrity check, the heading state, the heading-free fill-in, the constant-velocity ablation and the output
+// covariance's floor.
 
 #include <cmath>
 
@@ -16,6 +17,7 @@
 #include "canyon/fusion/heading_state.hpp"
 #include "canyon/fusion/innovation_gates.hpp"
 #include "canyon/fusion/integrity_check.hpp"
+#include "canyon/fusion/output_floor.hpp"
 #include "canyon/fusion/prior_recovery.hpp"
 #include "canyon/fusion/vio_fill_in.hpp"
 #include "canyon/fusion/vio_prediction.hpp"
@@ -286,6 +288,28 @@ TEST(FusionPieces, ConstantVelocityFromTheLastTwoSolutions) {
   EXPECT_NEAR(p->Q_E_m2(0, 0), 9.0 * 0.125 / 3.0, 1e-12);
   EXPECT_FALSE(predict_constant_velocity({a, b}, core::GpsTime{2200, 11.5}, b.time, 0.5, 3.0));  // too fast
   EXPECT_FALSE(predict_constant_velocity({b}, core::GpsTime{2200, 11.5}, b.time, 10.0, 3.0));
+}
+
+TEST(FusionPieces, TheOutputFloorAddsItsSigmasInTheLocalFrame) {
+  core::Solution s;
+  s.status = core::SolutionStatus::Fixed;
+  s.p_E_m = kP0;
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(kP0));
+  s.P_E_m2 = R_NE.transpose() * Eigen::Vector3d(1e-6, 4e-6, 9e-6).asDiagonal() * R_NE;  // 1, 2, 3 mm
+  add_output_floor(s, OutputFloorOptions{0.01, 0.02});
+  const Eigen::Matrix3d P_N = R_NE * s.P_E_m2 * R_NE.transpose();
+  EXPECT_NEAR(P_N(0, 0), 1e-6 + 1e-4, 1e-12);
+  EXPECT_NEAR(P_N(1, 1), 4e-6 + 1e-4, 1e-12);
+  EXPECT_NEAR(P_N(2, 2), 9e-6 + 4e-4, 1e-12);
+  EXPECT_NEAR(P_N(0, 1), 0.0, 1e-12);
+  // No solution, no covariance to floor; a zero floor changes nothing.
+  core::Solution none;
+  add_output_floor(none, OutputFloorOptions{0.01, 0.02});
+  EXPECT_TRUE(none.P_E_m2.isZero());
+  const Eigen::Matrix3d before = s.P_E_m2;
+  add_output_floor(s, OutputFloorOptions{0.0, 0.0});
+  EXPECT_EQ(s.P_E_m2, before);
+  EXPECT_FALSE((OutputFloorOptions{-0.01, 0.02}.validate().empty()));
 }
 
 }  // namespace

@@ -167,6 +167,8 @@ class FusionEngine {
   [[nodiscard]] std::optional<core::Solution> heading_free_solution(const core::GpsTime& t,
                                                                     const std::optional<VioPoseAt>& pose);
   FusionEpoch finish_heading_free();
+  /// finish_epoch() of an epoch the RTK filter solved (or failed to).
+  FusionEpoch finish_solved_epoch();
   void count_fix_refusals();
   void check_integrity(const Eigen::Vector3d& p_out_E_m);
 

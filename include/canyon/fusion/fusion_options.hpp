@@ -14,6 +14,7 @@
 #include "canyon/fusion/heading_state.hpp"
 #include "canyon/fusion/innovation_gates.hpp"
 #include "canyon/fusion/integrity_check.hpp"
+#include "canyon/fusion/output_floor.hpp"
 #include "canyon/fusion/prior_recovery.hpp"
 #include "canyon/fusion/time_bridge.hpp"
 #include "canyon/fusion/vio_prediction.hpp"
@@ -38,6 +39,7 @@ struct FusionOptions {
   HeadingFreeFillInOptions heading_free;
   FalseFixGuardOptions guard;
   PriorRecoveryOptions recovery;
+  OutputFloorOptions output_floor;
   double vio_keep_s = 120.0;  ///< VIO samples older than this before the epoch are forgotten (s; memory)
 
   /// Empty if valid, else the violated rule.
