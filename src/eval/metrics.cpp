@@ -121,9 +121,9 @@ void append_error_columns(std::string& out, const ErrorStats& e) {
 }
 
 /// Counts the solution in SolutionStats::epochs_with_covariance and, when e^T C^-1 e > 9, beyond_3_sigma_horizontal.
-void count_beyond_3_sigma(const core::Solution& s, const Eigen::Vector3d& p_E_truth_m, const Eigen::Vector3d& d_N_m,
+void count_beyond_3_sigma(const core::Solution& s, const core::Geodetic& truth, const Eigen::Vector3d& d_N_m,
                           SolutionStats& stats) {
-  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(p_E_truth_m));
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(truth);
   const Eigen::Matrix2d C = (R_NE * s.P_E_m2 * R_NE.transpose()).topLeftCorner<2, 2>();
   const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (C + C.transpose()));
   if (!C.allFinite() || llt.info() != Eigen::Success) return;
@@ -190,11 +190,12 @@ Result<SolutionStats> evaluate(const std::vector<core::Solution>& solutions, con
     const auto p_E_truth_m = truth->position_at(s.time);
     if (!p_E_truth_m) continue;
     ++stats.epochs_with_truth;
-    const Eigen::Vector3d d_N_m = core::ecef_to_enu(s.p_E_m - *p_E_truth_m, core::ecef_to_geodetic(*p_E_truth_m));
+    const core::Geodetic at_truth = core::ecef_to_geodetic(*p_E_truth_m);
+    const Eigen::Vector3d d_N_m = core::ecef_to_enu(s.p_E_m - *p_E_truth_m, at_truth);
     class_errors[static_cast<std::size_t>(c)].add(d_N_m);
     overall_errors.add(d_N_m);
     if (c == StatusClass::Fixed && d_N_m.norm() > options.wrong_fix_threshold_m) ++stats.wrong_fixes;
-    count_beyond_3_sigma(s, *p_E_truth_m, d_N_m, stats);
+    count_beyond_3_sigma(s, at_truth, d_N_m, stats);
   }
   for (std::size_t k = 0; k < kNumStatusClasses; ++k) {
     StatusStats& st = stats.by_class[k];

@@ -124,28 +124,33 @@ void check_post_fit(const std::vector<SingleDiff>& sds, const RtkOptions& option
 std::vector<DdRow> gated_rows(const FilterState& state, std::vector<SingleDiff>& sds, const RtkOptions& options,
                               const InnovationGate* gate, std::vector<core::SatelliteId>& rejected) {
   std::vector<DdRow> rows = dd_rows(state, sds);
-  std::vector<char> passes(rows.size(), 0);
-  std::vector<char> untestable(rows.size(), 0);
+  // Each row's verdict; an untestable phase row's is its code row's, known once every row is judged (code rows come
+  // after the phase rows).
+  enum class Verdict : char { Refused, Passes, FollowsCode };
+  std::vector<Verdict> verdicts(rows.size(), Verdict::Refused);
   std::vector<char> code_refused(sds.size(), 0);
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const DdRow& row = rows[k];
     const double limit_m = row.phase ? options.max_phase_innovation_m : options.max_code_innovation_m;
     bool pass = !(std::abs(row.innovation_m) > limit_m);
+    bool untestable = false;
     if (pass && gate != nullptr) {
       const double r = sd_variance(sds, row.phase, row.sd) + sd_variance(sds, row.phase, row.reference);
       const DdInnovation innovation(row, state.P(), r);
       pass = gate->passes(innovation);
       const double wavelength_m = sds[static_cast<std::size_t>(row.sd)].wavelength_m;
-      untestable[k] = row.phase && innovation.predicted_variance_m2() > wavelength_m * wavelength_m ? 1 : 0;
+      untestable = row.phase && innovation.predicted_variance_m2() > wavelength_m * wavelength_m;
       if (!pass && !row.phase) code_refused[static_cast<std::size_t>(row.sd)] = 1;
     }
-    passes[k] = pass ? 1 : 0;
+    if (pass) verdicts[k] = untestable ? Verdict::FollowsCode : Verdict::Passes;
   }
   std::vector<DdRow> kept;
   kept.reserve(rows.size());
   for (std::size_t k = 0; k < rows.size(); ++k) {
-    DdRow& row = rows[k];
-    if (passes[k] != 0 && !(untestable[k] != 0 && code_refused[static_cast<std::size_t>(row.sd)] != 0)) {
+    const DdRow& row = rows[k];
+    const bool passes = verdicts[k] == Verdict::Passes ||
+                        (verdicts[k] == Verdict::FollowsCode && code_refused[static_cast<std::size_t>(row.sd)] == 0);
+    if (passes) {
       kept.push_back(row);
       continue;
     }

@@ -5,18 +5,18 @@
 #include <algorithm>
 #include <cmath>
 
-#include "canyon/core/constants.hpp"
+#include "canyon/core/satellite.hpp"
 
 namespace canyon::rtk {
 
 namespace {
 
 constexpr double kEarthRadiusKm = 6371.0;
-constexpr double kL1Hz = 1575.42e6;
 
 /// k_s: the state's delay (metres on the satellite's first frequency) per metre of vertical L1 delay.
 double slant_factor(const SingleDiff& sd, const gnss::EphemerisStore& eph) {
-  const double ratio = first_wavelength_m(eph, sd.sat) / (core::kSpeedOfLightMps / kL1Hz);
+  static const double l1_wavelength_m = *core::wavelength_m(core::Constellation::Gps, core::SignalCode{'1', 'C'});
+  const double ratio = first_wavelength_m(eph, sd.sat) / l1_wavelength_m;
   return ionosphere_obliquity(sd.elevation_rad) * ratio * ratio;
 }
 
@@ -40,9 +40,13 @@ void add_ionosphere_states(FilterState& state, const std::vector<SingleDiff>& sd
     state.add(added);
     return;
   }
+  // k_s of each satellite (at its first SD), computed once: the held states are read in SD order for each new one.
+  std::vector<double> k(sds.size(), 0.0);
+  for (std::size_t i = 0; i < sds.size(); ++i) {
+    if (i == 0 || sds[i - 1].sat != sds[i].sat) k[i] = slant_factor(sds[i], eph);
+  }
   for (std::size_t i = 0; i < sds.size(); ++i) {
     if (!missing(i)) continue;
-    const SingleDiff& sd = sds[i];
     // The held states of this epoch's satellites, each an estimate of V = I_j / k_j with variance P_jj / k_j^2.
     std::vector<FilterState::Term> terms;
     double weight_sum = 0.0;
@@ -50,20 +54,18 @@ void add_ionosphere_states(FilterState& state, const std::vector<SingleDiff>& sd
       if (j > 0 && sds[j - 1].sat == sds[j].sat) continue;
       const int index = state.index({sds[j].sat, StateKey::kIonosphere});
       if (index < 0) continue;
-      const double k = slant_factor(sds[j], eph);
-      const double weight = k * k / state.P()(index, index);
-      terms.push_back({index, weight / k});
+      const double weight = k[j] * k[j] / state.P()(index, index);
+      terms.push_back({index, weight / k[j]});
       weight_sum += weight;
     }
-    const StateKey key{sd.sat, StateKey::kIonosphere};
+    const StateKey key{sds[i].sat, StateKey::kIonosphere};
     if (terms.empty() || !(weight_sum > 0.0) || !std::isfinite(weight_sum)) {
       state.add({{key, 0.0, prior.sigma_m * prior.sigma_m}});
       continue;
     }
-    const double k_new = slant_factor(sd, eph);
-    for (FilterState::Term& t : terms) t.weight *= k_new / weight_sum;
+    for (FilterState::Term& t : terms) t.weight *= k[i] / weight_sum;
     const double residual_m =
-        std::max(ionosphere_obliquity(sd.elevation_rad) * prior.residual_sigma_m, prior.min_sigma_m);
+        std::max(ionosphere_obliquity(sds[i].elevation_rad) * prior.residual_sigma_m, prior.min_sigma_m);
     state.add_combination(key, terms, residual_m * residual_m);
   }
 }
