@@ -21,6 +21,15 @@ double IntegrityCheck::median_offset_m(int axis) {
   return core::median_in_place(scratch_m_);
 }
 
+bool IntegrityCheck::spans_window(const core::GpsTime& t) const {
+  const core::GpsTime middle = t - 0.5 * options_.window_s;
+  int older = 0;
+  for (const Offset& o : offsets_) older += o.time - middle < 0.0 ? 1 : 0;
+  const int newer = static_cast<int>(offsets_.size()) - older;
+  const int needed = (options_.min_points + 1) / 2;
+  return older >= needed && newer >= needed;
+}
+
 std::optional<IntegrityRestart> IntegrityCheck::check(const core::GpsTime& t, const Eigen::Vector3d& p_out_E_m,
                                                       const Eigen::Matrix3d& P_out_E_m2,
                                                       const std::optional<Eigen::Vector3d>& spp_p_E_m) {
@@ -29,6 +38,9 @@ std::optional<IntegrityRestart> IntegrityCheck::check(const core::GpsTime& t, co
   offsets_.push_back(Offset{t, (R_NE * (*spp_p_E_m - p_out_E_m)).head<2>()});
   while (t - offsets_.front().time > options_.window_s) offsets_.pop_front();
   if (static_cast<int>(offsets_.size()) < options_.min_points) return std::nullopt;
+  // A window whose single points all came in its last seconds (after a blockage) is one stretch of NLOS, not a median
+  // over window_s.
+  if (!spans_window(t)) return std::nullopt;
   const Eigen::Vector2d median_m(median_offset_m(0), median_offset_m(1));
   if (median_m.norm() <= options_.max_offset_m) return std::nullopt;
   // An output that a share of the single points still agrees with has not left them: in a deep canyon the single

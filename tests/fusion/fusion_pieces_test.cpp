@@ -196,17 +196,19 @@ TEST(FusionPieces, PriorRecoveryReanchorsAfterRepeatedPriorOnlyFailuresAndWidens
 
 TEST(FusionPieces, TheIntegrityCheckRestartsWhenTheMedianSinglePointIsFarOff) {
   IntegrityCheckOptions options;
+  options.window_s = 10.0;
   options.min_points = 10;
   options.max_offset_m = 20.0;
   IntegrityCheck check(options);
   const Eigen::Matrix3d R_EN = core::rotation_enu_from_ecef(core::ecef_to_geodetic(kP0)).transpose();
   const Eigen::Matrix3d P_out = Eigen::Matrix3d::Identity() * 0.01;
   std::optional<IntegrityRestart> restart;
-  for (int k = 0; k < 10 && !restart; ++k) {
+  for (int k = 0; k <= 10 && !restart; ++k) {
     const Eigen::Vector3d spp = kP0 + R_EN * Eigen::Vector3d(30.0 + (k % 3), -5.0, 2.0);
     restart = check.check(core::GpsTime{2200, static_cast<double>(k)}, kP0, P_out, spp);
-    if (k < 9) {
-      EXPECT_FALSE(restart.has_value()) << k;  // fewer than min_points
+    if (k < 10) {
+      // fewer than min_points, then (k = 9) fewer than half of them in the window's older half
+      EXPECT_FALSE(restart.has_value()) << k;
     }
   }
   ASSERT_TRUE(restart.has_value());
@@ -215,6 +217,19 @@ TEST(FusionPieces, TheIntegrityCheckRestartsWhenTheMedianSinglePointIsFarOff) {
   EXPECT_NEAR(moved_N.y(), -5.0, 1e-6);
   EXPECT_NEAR(moved_N.z(), 0.0, 1e-6);  // the vertical stays
   EXPECT_NEAR(restart->offset_m, std::hypot(31.0, 5.0), 1e-6);
+  // Single points that come back after a blockage, many and all far off within a few seconds (downtown seed 17), are
+  // no median over the window: no restart until the window's older half holds half of min_points of them too.
+  IntegrityCheck after_blockage(options);
+  std::optional<double> restarted_at_s;
+  for (int k = 0; k < 100 && !restarted_at_s; ++k) {
+    const double t_s = 6.0 + 0.1 * k;
+    if (after_blockage.check(core::GpsTime{2200, t_s}, kP0, P_out, kP0 + R_EN * Eigen::Vector3d(0.0, -80.0, 0.0))) {
+      restarted_at_s = t_s;
+    }
+  }
+  ASSERT_TRUE(restarted_at_s.has_value());
+  EXPECT_GT(*restarted_at_s, 11.3);  // 5 points before t - 5 s: t >= 11.4 s
+  EXPECT_LT(*restarted_at_s, 11.6);
   // Points close to the output never restart; no single point, no test.
   IntegrityCheck quiet(options);
   for (int k = 0; k < 20; ++k) {
