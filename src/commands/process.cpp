@@ -319,14 +319,17 @@ void report_vio_segments(const fusion::VioTrack& track, const fusion::VioTrackOp
   if (notes.size() <= kMaxSegmentNotes) return;
   int gaps = 0;
   int jumps = 0;
+  int steps = 0;
   for (std::size_t i = kMaxSegmentNotes; i < notes.size(); ++i) {
     if (notes[i].rfind("VIO gap", 0) == 0) ++gaps;
     if (notes[i].rfind("VIO jump", 0) == 0) ++jumps;
+    if (notes[i].rfind("VIO time-sync step", 0) == 0) ++steps;
   }
   const auto rest = static_cast<int>(notes.size() - kMaxSegmentNotes);
   summary.report.push_back("fusion: ... and " + std::to_string(rest) + " more VIO segment breaks (" +
                            std::to_string(gaps) + " gaps, " + std::to_string(jumps) + " jumps, " +
-                           std::to_string(rest - gaps - jumps) + " covariance resets)");
+                           std::to_string(steps) + " time-sync steps, " + std::to_string(rest - gaps - jumps - steps) +
+                           " covariance resets)");
 }
 
 /// The VIO track with the causal time bridge (fusion.timesync_mode: causal): every pose mapped as the live rover maps
@@ -358,7 +361,8 @@ Result<fusion::VioTrack> load_vio_causal(const config::ProcessConfig& config, co
       continue;
     }
     std::string note;
-    (void)track.append(record, *t, &note);  // a fit cannot reorder poses a few ms apart; if it did, dropped
+    // A fit cannot reorder poses a few ms apart; after a time-sync step back in GPST the first poses are dropped.
+    (void)track.append(record, *t, &note, bridge.steps_seen());
     if (!note.empty()) notes.push_back(note);
   }
   if (unmapped > 0) {

@@ -63,9 +63,9 @@ std::optional<VioPoseAt> FusionEngine::bridge(const core::GpsTime& t) const {
   return track_.pose_at(t);
 }
 
-bool FusionEngine::add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note) {
+bool FusionEngine::add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note, int clock_piece) {
   const std::unique_lock lock(track_mutex_);
-  return track_.append(record, t, note);
+  return track_.append(record, t, note, clock_piece);
 }
 
 bool FusionEngine::vio_covers(const core::GpsTime& t) const {

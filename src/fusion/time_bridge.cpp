@@ -44,9 +44,134 @@ core::GpsTime TimeBridge::to_gps(std::int64_t t_ns) const {
     const std::int64_t rest_ns = t_ns - week * kNsPerWeek;
     return core::GpsTime{static_cast<int>(week), static_cast<double>(rest_ns) * 1e-9}.normalized();
   }
+  const Piece& piece = pieces_[static_cast<std::size_t>(piece_of(t_ns))];
   const double x_s = static_cast<double>(t_ns - reference_ns_) * 1e-9;
-  return reference_time_ + (a_s_ + b_ * x_s);
+  return reference_time_ + (piece.a_s + piece.b * x_s);
 }
+
+int TimeBridge::piece_of(std::int64_t t_ns) const {
+  int k = 0;
+  while (k + 1 < static_cast<int>(pieces_.size()) && pieces_[static_cast<std::size_t>(k) + 1].from_ns <= t_ns) ++k;
+  return k;
+}
+
+namespace {
+
+/// One line y = a + b x fitted to pairs [begin, end) (robust start, then iterated least squares on the inliers; see
+/// the header), with its inliers and their residuals.
+struct LineFit {
+  double a = 0.0;
+  double b = 1.0;
+  std::vector<bool> inlier;  // of [begin, end)
+  int inliers = 0;
+  double residual_rms_s = 0.0;
+  double max_residual_s = 0.0;
+};
+
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y, std::size_t begin, std::size_t end,
+                 const TimeBridgeOptions& options) {
+  const std::size_t n = end - begin;
+  // 1. Robust start: median slope between pairs half the set apart, median intercept.
+  std::vector<double> slopes;
+  const std::size_t half = std::max<std::size_t>(n / 2, 1);
+  for (std::size_t i = begin; i + half < end; ++i) {
+    const double dx = x[i + half] - x[i];
+    if (dx > 0.0) slopes.push_back((y[i + half] - y[i]) / dx);
+  }
+  if (slopes.empty()) {
+    for (std::size_t i = begin + 1; i < end; ++i) {
+      if (x[i] > x[begin]) slopes.push_back((y[i] - y[begin]) / (x[i] - x[begin]));
+    }
+  }
+  LineFit fit;
+  double b = median(slopes);
+  std::vector<double> intercepts(n);
+  for (std::size_t i = 0; i < n; ++i) intercepts[i] = y[begin + i] - b * x[begin + i];
+  double a = median(intercepts);
+
+  // 2. Iterated least squares on the inliers of a robust threshold.
+  std::vector<bool> inlier(n, true);
+  std::vector<double> abs_residual(n);
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    for (std::size_t i = 0; i < n; ++i) abs_residual[i] = std::abs(y[begin + i] - a - b * x[begin + i]);
+    const double sigma = kMadToSigma * median(abs_residual);
+    const double threshold = std::max(options.outlier_sigmas * sigma, options.min_outlier_threshold_s);
+    std::vector<bool> next(n);
+    double sw = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      next[i] = abs_residual[i] <= threshold;
+      if (!next[i]) continue;
+      sw += 1.0;
+      sx += x[begin + i];
+      sy += y[begin + i];
+      sxx += x[begin + i] * x[begin + i];
+      sxy += x[begin + i] * y[begin + i];
+    }
+    const double det = sw * sxx - sx * sx;
+    if (sw < 2.0 || !(det > 0.0)) break;
+    b = (sw * sxy - sx * sy) / det;
+    a = (sy - b * sx) / sw;
+    const bool same = next == inlier;
+    inlier = std::move(next);
+    if (same && iteration > 0) break;
+  }
+  double sum2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!inlier[i]) continue;
+    const double r = std::abs(y[begin + i] - a - b * x[begin + i]);
+    sum2 += r * r;
+    fit.max_residual_s = std::max(fit.max_residual_s, r);
+    ++fit.inliers;
+  }
+  fit.residual_rms_s = fit.inliers > 0 ? std::sqrt(sum2 / fit.inliers) : 0.0;
+  fit.a = a;
+  fit.b = b;
+  fit.inlier = std::move(inlier);
+  return fit;
+}
+
+/// Where the pairs step (see the header): the indices that start a new piece.
+std::vector<std::size_t> find_steps(const std::vector<double>& x, const std::vector<double>& y, double threshold_s) {
+  constexpr std::size_t kSide = 9;      // pairs on each side whose median offsets must differ
+  constexpr std::size_t kMinAfter = 5;  // pairs after a step before it counts (a few late outliers are no step)
+  const std::size_t n = x.size();
+  const auto offset = [&](std::size_t i) { return y[i] - x[i]; };
+  const auto median_offset = [&](std::size_t from, std::size_t to) {
+    std::vector<double> d;
+    for (std::size_t i = from; i < to; ++i) d.push_back(offset(i));
+    return median(d);
+  };
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 1; i + kMinAfter <= n; ++i) {
+    if (std::abs(offset(i) - offset(i - 1)) <= threshold_s) continue;
+    const std::size_t piece_start = starts.empty() ? 0 : starts.back();
+    const std::size_t from = std::max(piece_start, i >= kSide ? i - kSide : 0);
+    const std::size_t to = std::min(n, i + kSide);
+    if (std::abs(median_offset(i, to) - median_offset(from, i)) > threshold_s) starts.push_back(i);
+  }
+  return starts;
+}
+
+/// The rules a piece's fit must meet (header), as an error naming the piece's lines when there are several.
+std::optional<Error> check_piece(const LineFit& line, std::size_t pairs, const std::string& where,
+                                 const TimeBridgeOptions& options) {
+  if (2 * line.inliers < static_cast<int>(pairs)) {
+    return Error{"time sync" + where + ": only " + std::to_string(line.inliers) + " of " + std::to_string(pairs) +
+                 " pairs agree on one clock offset and drift"};
+  }
+  if (line.residual_rms_s > options.max_residual_rms_s) {
+    return Error{"time sync" + where + ": residual RMS " + std::to_string(line.residual_rms_s * 1e3) + " ms exceeds " +
+                 std::to_string(options.max_residual_rms_s * 1e3) + " ms"};
+  }
+  const double drift_ppm = (1.0 / line.b - 1.0) * 1e6;
+  if (std::abs(drift_ppm) > options.max_drift_ppm) {
+    return Error{"time sync" + where + ": fitted device clock drift " + std::to_string(drift_ppm) +
+                 " ppm is beyond the " + std::to_string(options.max_drift_ppm) + " ppm allowed"};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& input, const TimeBridgeOptions& options) {
   if (const std::string e = options.validate(); !e.empty()) return Error{"time bridge: " + e};
@@ -72,74 +197,60 @@ Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& input
   }
   if (x.back() <= 0.0) return Error{"all time-sync pairs have the same device time: no clock rate can be fitted"};
 
-  // 1. Robust start: median slope between pairs half the set apart, median intercept.
-  std::vector<double> slopes;
-  const std::size_t half = std::max<std::size_t>(n / 2, 1);
-  for (std::size_t i = 0; i + half < n; ++i) {
-    const double dx = x[i + half] - x[i];
-    if (dx > 0.0) slopes.push_back((y[i + half] - y[i]) / dx);
+  std::vector<std::size_t> starts = find_steps(x, y, options.max_residual_rms_s);
+  starts.insert(starts.begin(), 0);
+  const std::size_t pieces = starts.size();
+  const auto piece_end = [&](std::size_t k) { return k + 1 < pieces ? starts[k + 1] : n; };
+  std::vector<LineFit> lines(pieces);
+  std::size_t longest = 0;
+  for (std::size_t k = 0; k < pieces; ++k) {
+    if (piece_end(k) - starts[k] >= 2) lines[k] = fit_line(x, y, starts[k], piece_end(k), options);
+    if (piece_end(k) - starts[k] > piece_end(longest) - starts[longest]) longest = k;
   }
-  if (slopes.empty()) {
-    for (std::size_t i = 1; i < n; ++i) {
-      if (x[i] > x[0]) slopes.push_back((y[i] - y[0]) / (x[i] - x[0]));
-    }
-  }
-  double b = median(slopes);
-  std::vector<double> intercepts(n);
-  for (std::size_t i = 0; i < n; ++i) intercepts[i] = y[i] - b * x[i];
-  double a = median(intercepts);
-
-  // 2. Iterated least squares on the inliers of a robust threshold.
-  std::vector<bool> inlier(n, true);
-  std::vector<double> abs_residual(n);
-  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
-    for (std::size_t i = 0; i < n; ++i) abs_residual[i] = std::abs(y[i] - a - b * x[i]);
-    const double sigma = kMadToSigma * median(abs_residual);
-    const double threshold = std::max(options.outlier_sigmas * sigma, options.min_outlier_threshold_s);
-    std::vector<bool> next(n);
-    double sw = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      next[i] = abs_residual[i] <= threshold;
-      if (!next[i]) continue;
-      sw += 1.0;
-      sx += x[i];
-      sy += y[i];
-      sxx += x[i] * x[i];
-      sxy += x[i] * y[i];
-    }
-    const double det = sw * sxx - sx * sx;
-    if (sw < 2.0 || !(det > 0.0)) break;
-    b = (sw * sxy - sx * sy) / det;
-    a = (sy - b * sx) / sw;
-    const bool same = next == inlier;
-    inlier = std::move(next);
-    if (same && iteration > 0) break;
-  }
+  std::vector<TimeBridge::Piece> map;
   double sum2 = 0.0;
   int inliers = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double r = std::abs(y[i] - a - b * x[i]);
-    if (!inlier[i]) {
-      fit.outlier_lines.push_back(pairs[i].line);
-      continue;
+  for (std::size_t k = 0; k < pieces; ++k) {
+    const std::size_t begin = starts[k];
+    const std::size_t end = piece_end(k);
+    LineFit& line = lines[k];
+    if (end - begin < 2) {
+      // One pair: the offset only, with the drift of the longest piece.
+      line.b = lines[longest].b;
+      line.a = y[begin] - line.b * x[begin];
+      line.inlier.assign(1, true);
+    } else {
+      const std::string where = pieces == 1 ? std::string{}
+                                            : " (pairs at lines " + std::to_string(pairs[begin].line) + " to " +
+                                                  std::to_string(pairs[end - 1].line) + ")";
+      if (auto e = check_piece(line, end - begin, where, options)) return *e;
     }
-    sum2 += r * r;
-    fit.max_residual_s = std::max(fit.max_residual_s, r);
-    ++inliers;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!line.inlier[i - begin]) {
+        fit.outlier_lines.push_back(pairs[i].line);
+        continue;
+      }
+      const double r = std::abs(y[i] - line.a - line.b * x[i]);
+      sum2 += r * r;
+      fit.max_residual_s = std::max(fit.max_residual_s, r);
+      ++inliers;
+    }
+    map.push_back(TimeBridge::Piece{pairs[begin].t_ns, line.a, line.b});
+    if (k > 0) {
+      const double step_s = (line.a + line.b * x[begin]) - (lines[k - 1].a + lines[k - 1].b * x[begin]);
+      fit.steps.push_back(TimeSyncStep{pairs[begin - 1].line, pairs[begin].line, pairs[begin].t_ns, step_s});
+    }
   }
   fit.residual_rms_s = inliers > 0 ? std::sqrt(sum2 / inliers) : 0.0;
-  fit.bridge = TimeBridge(n_ref, t_ref, a, b);
-  if (2 * inliers < static_cast<int>(n)) {
-    return Error{"time sync: only " + std::to_string(inliers) + " of " + std::to_string(n) +
-                 " pairs agree on one clock offset and drift"};
-  }
-  if (fit.residual_rms_s > options.max_residual_rms_s) {
-    return Error{"time sync: residual RMS " + std::to_string(fit.residual_rms_s * 1e3) + " ms exceeds " +
-                 std::to_string(options.max_residual_rms_s * 1e3) + " ms"};
-  }
-  if (std::abs(fit.bridge.drift_ppm()) > options.max_drift_ppm) {
-    return Error{"time sync: fitted device clock drift " + std::to_string(fit.bridge.drift_ppm()) +
-                 " ppm is beyond the " + std::to_string(options.max_drift_ppm) + " ppm allowed"};
+  fit.bridge = TimeBridge(n_ref, t_ref, std::move(map));
+  for (const TimeSyncStep& step : fit.steps) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the GPST of the device clock steps by %+.3f s between the pairs at lines %d and %d: fitted in "
+                  "pieces; the VIO poses after it are stitched to those before (vio_stitch_resets) or start a new "
+                  "segment",
+                  step.step_s, step.line_before, step.line_after);
+    fit.warnings.emplace_back(text);
   }
   return fit;
 }
@@ -199,6 +310,10 @@ Result<core::GpsTime> CausalTimeBridge::to_gps(std::int64_t t_ns) {
     }
   }
   if (fit_error_) return *fit_error_;
+  if (!fit_->steps.empty() && fit_->steps.back().t_ns > last_step_ns_) {
+    ++steps_seen_;
+    last_step_ns_ = fit_->steps.back().t_ns;
+  }
   return fit_->bridge.to_gps(t_ns);
 }
 

@@ -63,6 +63,11 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
   const double trace = s.P.topLeftCorner<3, 3>().trace();
   const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
   char buffer[160];
+  if (s.clock_piece != prev.clock_piece) {
+    std::snprintf(buffer, sizeof buffer, "VIO time-sync step (%.2f s after the previous pose on GPST)", dt_s);
+    set(SegmentBreak::TimeSyncStep);
+    return buffer;
+  }
   if (dt_s > std::max(options.max_gap_s, kGapIntervals * nominal_interval_s)) {
     std::snprintf(buffer, sizeof buffer, "VIO gap of %.2f s (poses %.2f s apart before it)", dt_s, nominal_interval_s);
     set(SegmentBreak::Gap);
@@ -139,7 +144,11 @@ void place_in_segment(const VioTrackSample* before_prev, const VioTrackSample* p
     return;
   }
   const std::string where = " at " + core::format_gpst(reference + s.t_s, 3) + " (line " + std::to_string(s.line) + ")";
-  if ((kind == SegmentBreak::Jump || kind == SegmentBreak::CovarianceReset) && options.stitch_frame_resets) {
+  // A jump or reset moved the VIO's frame; a time-sync step moved its poses in time (the frame is the same): either
+  // way the device did not move, and the poses after it are stitched to the ones before.
+  const bool stitchable =
+      kind == SegmentBreak::Jump || kind == SegmentBreak::CovarianceReset || kind == SegmentBreak::TimeSyncStep;
+  if (stitchable && options.stitch_frame_resets) {
     stitch_to(before_prev, *prev, s, options, stitch);
     if (note != nullptr) {
       *note = why + where + ": the new frame stitched to the old one (the device's pose taken as continuous), the " +
@@ -174,10 +183,17 @@ Result<VioTrack> VioTrack::build(const io::VioFile& file, const TimeBridge& brid
   const core::GpsTime reference = bridge.to_gps(file.records.front().t_ns);
   std::vector<VioTrackSample> samples;
   samples.reserve(file.records.size());
+  int overlapped = 0;
   for (const io::VioRecord& r : file.records) {
     VioTrackSample s;
     s.t_s = bridge.to_gps(r.t_ns) - reference;
-    if (!samples.empty() && !(s.t_s > samples.back().t_s)) continue;  // a clock fit cannot reorder, but be safe
+    s.clock_piece = bridge.piece_of(r.t_ns);
+    // A clock fit cannot reorder poses, but after a time-sync step back in GPST the next piece's first poses fall
+    // before the last ones mapped: those are left out.
+    if (!samples.empty() && !(s.t_s > samples.back().t_s)) {
+      ++overlapped;
+      continue;
+    }
     s.T_OI = r.T_OI;
     s.P = r.covariance;
     if (options.use_cross_covariance && r.cross_previous) s.C_previous = *r.cross_previous;
@@ -185,6 +201,10 @@ Result<VioTrack> VioTrack::build(const io::VioFile& file, const TimeBridge& brid
     samples.push_back(s);
   }
   assign_segments(samples, options, reference, &notes);
+  if (overlapped > 0) {
+    notes.push_back(std::to_string(overlapped) +
+                    " VIO poses mapped to GPST no later than the pose before them (after a time-sync step): left out");
+  }
   return VioTrack(std::move(samples), reference, options);
 }
 
@@ -198,10 +218,11 @@ VioTrack VioTrack::streaming(const VioTrackOptions& options) {
   return VioTrack({}, core::GpsTime{}, options);
 }
 
-bool VioTrack::append(const io::VioRecord& record, const core::GpsTime& t, std::string* note) {
+bool VioTrack::append(const io::VioRecord& record, const core::GpsTime& t, std::string* note, int clock_piece) {
   if (samples_.empty() && forgotten_ == 0) reference_ = t;
   VioTrackSample s;
   s.t_s = t - reference_;
+  s.clock_piece = clock_piece;
   if (!samples_.empty() && !(s.t_s > samples_.back().t_s)) return false;
   s.T_OI = record.T_OI;
   s.P = record.covariance;

@@ -81,7 +81,7 @@ void LiveVio::map_ready() {
                                                 " ns not mapped to GPST: " + t.error().message);
     } else {
       std::string note;
-      if (engine_.add_vio(pose, *t, &note)) {
+      if (engine_.add_vio(pose, *t, &note, bridge_.steps_seen())) {
         appended_.fetch_add(1);
       } else {
         warn_once(out_of_order_.fetch_add(1) + 1, "VIO pose at device time " + std::to_string(pose.t_ns) +

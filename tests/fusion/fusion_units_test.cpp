@@ -3,6 +3,7 @@
 // differences, alignment and lever-arm calibration on synthetic data, the PCA gate, the C/N0 screen, the epoch geometry
 // built ahead of the engine.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -71,6 +72,7 @@ TEST(TimeBridgeTest, RecoversTheClockWithin1msFromJitteryDriftingPairsWithOutlie
   EXPECT_NEAR(fit->residual_rms_s, kJitterS, 0.001);
   EXPECT_GE(static_cast<int>(fit->outlier_lines.size()), outliers - 3);  // a few outliers fall within the jitter
   EXPECT_LE(static_cast<int>(fit->outlier_lines.size()), outliers + 5);
+  EXPECT_TRUE(fit->steps.empty()) << "outliers are no step";
   std::printf("time bridge: worst mapping error %.3f ms, drift %.2f ppm, residual RMS %.2f ms, %zu of %d outliers\n",
               worst_s * 1e3, fit->bridge.drift_ppm(), fit->residual_rms_s * 1e3, fit->outlier_lines.size(), outliers);
 }
@@ -84,6 +86,53 @@ TEST(TimeBridgeTest, OnePairGivesTheOffsetOnlyWithAWarningAndNoneIsAnError) {
   EXPECT_NE(fit->warnings[0].find("one time-sync pair"), std::string::npos);
   EXPECT_FALSE(fit_time_bridge({}).ok());
   EXPECT_FALSE(fit_time_bridge({io::TimeSyncPair{5, t, 2}, io::TimeSyncPair{5, t + 1.0, 3}}).ok());
+}
+
+TEST(TimeBridgeTest, AStepOfTheTimeSyncIsFittedInPiecesAndOutlierPairsAreNot) {
+  // 200 pairs at 1 Hz of a device clock 50 ppm fast, 0.5 ms jitter; from pair 100 on the same GPST comes with a
+  // device time 1 s later (the clock was set back, or the sync restarted); outliers: one pair at 50, two at 150-151,
+  // and in a second run the last four pairs only (too few after them to be a step).
+  const core::GpsTime start{2266, 316800.0};
+  const auto device_s = [](double t_s) { return 100.0 + t_s * (1.0 + 50e-6); };
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> jitter(0.0, 5e-4);
+  const auto pairs_with = [&](int stepped_from) {
+    std::vector<io::TimeSyncPair> pairs;
+    for (int k = 0; k < 200; ++k) {
+      double e_s = jitter(rng);
+      if (k >= stepped_from) e_s += 1.0;
+      if (k == 50) e_s += 0.5;
+      if (k == 150 || k == 151) e_s -= 0.3;
+      pairs.push_back(io::TimeSyncPair{std::llround((device_s(k) + e_s) * 1e9), start + k, k + 2});
+    }
+    return pairs;
+  };
+  auto fit = fit_time_bridge(pairs_with(100));
+  ASSERT_TRUE(fit.ok()) << fit.error().to_string();
+  ASSERT_EQ(fit->steps.size(), 1U);
+  EXPECT_EQ(fit->steps[0].line_before, 101);  // pair 99
+  EXPECT_EQ(fit->steps[0].line_after, 102);   // pair 100
+  EXPECT_NEAR(fit->steps[0].step_s, -1.0, 2e-3);
+  EXPECT_EQ(fit->bridge.pieces(), 2);
+  for (const double t_s : {0.0, 30.0, 98.5, 100.0, 160.0, 199.0}) {
+    const double stepped_s = t_s >= 99.5 ? 1.0 : 0.0;
+    const auto t_ns = std::llround((device_s(t_s) + stepped_s) * 1e9);
+    EXPECT_LT(std::abs(fit->bridge.to_gps(t_ns) - (start + t_s)), 1e-3) << t_s;
+    EXPECT_EQ(fit->bridge.piece_of(t_ns), stepped_s > 0.0 ? 1 : 0) << t_s;
+  }
+  const std::vector<int> outliers = fit->outlier_lines;
+  for (const int line : {52, 152, 153}) {
+    EXPECT_NE(std::find(outliers.begin(), outliers.end(), line), outliers.end()) << line;
+  }
+  ASSERT_FALSE(fit->warnings.empty());
+  EXPECT_NE(fit->warnings[0].find("steps by -1.000 s between the pairs at lines 101 and 102"), std::string::npos)
+      << fit->warnings[0];
+
+  auto late = fit_time_bridge(pairs_with(196));
+  ASSERT_TRUE(late.ok()) << late.error().to_string();
+  EXPECT_TRUE(late->steps.empty());
+  EXPECT_EQ(late->bridge.pieces(), 1);
+  EXPECT_EQ(late->outlier_lines.size(), 7U);  // 52, 152, 153 and the last four
 }
 
 TEST(TimeBridgeTest, GpsClockStampsMapDirectly) {
@@ -249,6 +298,36 @@ TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   EXPECT_FALSE(track.pose_at(ref + 100.0).has_value());  // after the last
 }
 
+TEST(VioTrackTest, ATimeSyncStepIsStitchedAndThePosesItMapsBeforeTheLastAreLeftOut) {
+  // Poses every 0.1 s of a straight walk at 1.4 m/s (device time = GPST from ref); from device time 5 s on the time
+  // bridge maps 1 s earlier (a second piece). Poses at device 5.0-5.9 s map to GPST 4.0-4.9 s, not after the last
+  // one: left out; the one at 6.0 s (GPST 5.0 s) is the first after the step, stitched to the pose before.
+  const core::GpsTime ref{2266, 100.0};
+  io::VioFile file;
+  const std::vector<VioTrackSample> s = straight_samples(101, 0.1, 1.4);
+  for (const VioTrackSample& v : s) {
+    file.records.push_back(io::VioRecord{std::llround(v.t_s * 1e9), v.T_OI, v.P, std::nullopt, v.line});
+  }
+  const TimeBridge bridge(0, ref, {TimeBridge::Piece{0, 0.0, 1.0}, TimeBridge::Piece{5'000'000'000, -1.0, 1.0}});
+  for (const bool stitch : {true, false}) {
+    VioTrackOptions options;
+    options.stitch_frame_resets = stitch;
+    std::vector<std::string> notes;
+    auto track = VioTrack::build(file, bridge, options, notes);
+    ASSERT_TRUE(track.ok());
+    EXPECT_EQ(track->samples().size(), 91U);  // 10 left out
+    EXPECT_EQ(track->segments(), stitch ? 1 : 2);
+    ASSERT_EQ(notes.size(), 2U);
+    EXPECT_NE(notes[0].find("VIO time-sync step"), std::string::npos) << notes[0];
+    EXPECT_NE(notes[0].find(stitch ? "stitched" : "new VIO segment"), std::string::npos) << notes[0];
+    EXPECT_NE(notes[1].find("10 VIO poses"), std::string::npos) << notes[1];
+    const VioTrackSample& first_after = track->samples()[50];
+    EXPECT_NEAR(first_after.t_s, 5.0, 1e-9);
+    // Stitched: continuous with the pose at 4.9 s (6.86 m) moved on by one interval; as given: 8.4 m.
+    EXPECT_NEAR(first_after.T_OI.p.x(), stitch ? 7.0 : 8.4, 1e-4);  // SE(3) extrapolation of a slow turn
+  }
+}
+
 // A jump in position or a covariance reset is a new odometry frame: stitched to the old one, the device's pose
 // continuous (extrapolated by the last increment), the increments inside the new frame with their variances; a gap and
 // a turn too fast with the position continuous still start a segment.
@@ -327,6 +406,25 @@ TEST(CausalTimeBridgeTest, MapsWithThePairsOlderThanTheHoldOnlyAndOnlyOnceTheyAr
     auto got = bridge.to_gps(t_ns);
     ASSERT_TRUE(got.ok()) << got.error().to_string();
     EXPECT_EQ(*got - expected->bridge.to_gps(t_ns), 0.0) << t_s;
+    EXPECT_LT(std::abs(*got - (start + t_s)), 3e-3) << t_s;
+  }
+  // A step (the same GPST with a device time 1 s later from pair 20 on): mapped with the old line until five pairs
+  // after it are old enough to use, then with the new piece, the step counted once.
+  TimeBridgeOptions wide = options;
+  wide.causal_window_pairs = 30;
+  CausalTimeBridge stepped(wide);
+  const auto stepped_ns = [&](double t_s) { return device_ns(t_s) + (t_s >= 19.5 ? 1'000'000'000 : 0); };
+  for (int k = 0; k < 40; ++k) ASSERT_TRUE(stepped.add(io::TimeSyncPair{stepped_ns(k), start + k, k + 2}).ok());
+  for (const double t_s : {10.0, 21.0, 24.0}) {
+    auto got = stepped.to_gps(stepped_ns(t_s));
+    ASSERT_TRUE(got.ok()) << t_s;
+    EXPECT_EQ(stepped.steps_seen(), 0) << t_s;
+    EXPECT_NEAR(*got - (start + t_s), t_s >= 19.5 ? 1.0 : 0.0, 3e-3) << t_s;  // the old line: 1 s late
+  }
+  for (const double t_s : {26.0, 30.0, 38.0}) {
+    auto got = stepped.to_gps(stepped_ns(t_s));
+    ASSERT_TRUE(got.ok()) << t_s;
+    EXPECT_EQ(stepped.steps_seen(), 1) << t_s;
     EXPECT_LT(std::abs(*got - (start + t_s)), 3e-3) << t_s;
   }
   CausalTimeBridge gps = CausalTimeBridge::gps_clock();

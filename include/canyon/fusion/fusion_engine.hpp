@@ -125,7 +125,7 @@ class FusionEngine {
   // reader-writer lock: appends (the time bridge's thread) exclude the readers (bridge(), the prediction); forgetting
   // happens in align().
   /// Appends a pose at GPST t to the track (VioTrack::append); false if not after the last one.
-  bool add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr);
+  bool add_vio(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr, int clock_piece = 0);
   /// The track has the poses that make bridge(t) final (VioTrack::covers).
   [[nodiscard]] bool vio_covers(const core::GpsTime& t) const;
   /// The base position from the next epoch on (rtk::RtkEngine::set_base_position).

@@ -11,6 +11,13 @@
 //   2. repeat: residuals r_i = y_i - a - b x_i, sigma = 1.4826 median|r_i|, inliers |r_i| <= max(k sigma, r_min),
 //      least squares on the inliers, until the inlier set no longer changes (at most 20 times).
 // Reported: a, b (as the drift in ppm), the inliers' residual RMS and largest residual, and the rejected pairs.
+// Steps: a device whose clock or GPS time-sync jumps (a clock set, a receiver restart) gives pairs whose offset
+// y - x changes at once and stays changed. A step is where consecutive pairs' offsets differ by more than
+// max_residual_rms_s and the median offsets of up to 9 pairs on each side (at least 5 after it) differ by as much (a
+// few outlier pairs are no step). The pairs are then fitted in pieces, one per stretch between steps (a piece of one
+// pair takes the drift of the longest piece), each pose is mapped with the piece its device time falls in, and the
+// VIO track breaks at each step (vio_track.hpp: the poses after it are stitched to those before, as after a frame
+// reset, or start a new segment): the two pieces cannot both be right about the poses, so no increment spans it.
 // One pair determines the offset only: b = 1 (drift taken as zero), with a warning. VIO already on GPST (t_ns =
 // GPST nanoseconds since 1980-01-06 00:00:00) needs no pairs: TimeBridge::gps_clock().
 //
@@ -26,6 +33,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "canyon/core/result.hpp"
@@ -47,40 +55,62 @@ struct TimeBridgeOptions {
   [[nodiscard]] std::string validate() const;
 };
 
-/// Device clock -> GPST.
+/// Device clock -> GPST: one line, or one line per piece between the steps of the time sync.
 class TimeBridge {
  public:
+  /// One line of the map, used from device time from_ns on (the first piece also before it).
+  struct Piece {
+    std::int64_t from_ns = 0;
+    double a_s = 0.0;
+    double b = 1.0;
+  };
   /// The identity for VIO stamped with GPST nanoseconds since the GPS epoch.
   static TimeBridge gps_clock();
   TimeBridge(std::int64_t reference_ns, core::GpsTime reference_time, double a_s, double b)
-      : reference_ns_(reference_ns), reference_time_(reference_time), a_s_(a_s), b_(b) {}
+      : reference_ns_(reference_ns), reference_time_(reference_time), pieces_{Piece{reference_ns, a_s, b}} {}
+  /// Pieces in increasing from_ns, at least one.
+  TimeBridge(std::int64_t reference_ns, core::GpsTime reference_time, std::vector<Piece> pieces)
+      : reference_ns_(reference_ns), reference_time_(reference_time), pieces_(std::move(pieces)) {}
 
   [[nodiscard]] core::GpsTime to_gps(std::int64_t t_ns) const;
-  [[nodiscard]] double offset_s() const { return a_s_; }
-  /// Device clock rate error: the device runs fast by this (1e-6).
-  [[nodiscard]] double drift_ppm() const { return (1.0 / b_ - 1.0) * 1e6; }
+  /// The piece that maps t_ns (0 with one piece).
+  [[nodiscard]] int piece_of(std::int64_t t_ns) const;
+  [[nodiscard]] int pieces() const { return static_cast<int>(pieces_.size()); }
+  /// Of the first piece.
+  [[nodiscard]] double offset_s() const { return gps_clock_ ? 0.0 : pieces_.front().a_s; }
+  /// Device clock rate error: the device runs fast by this (1e-6), of the first piece.
+  [[nodiscard]] double drift_ppm() const { return gps_clock_ ? 0.0 : (1.0 / pieces_.front().b - 1.0) * 1e6; }
   [[nodiscard]] bool is_gps_clock() const { return gps_clock_; }
 
  private:
   TimeBridge() = default;
   std::int64_t reference_ns_ = 0;
   core::GpsTime reference_time_;
-  double a_s_ = 0.0;
-  double b_ = 1.0;
+  std::vector<Piece> pieces_;
   bool gps_clock_ = false;
+};
+
+/// A step of the time sync between two consecutive pairs.
+struct TimeSyncStep {
+  int line_before = 0;    ///< the last pair before it (line in the time-sync file)
+  int line_after = 0;     ///< the first pair after it
+  std::int64_t t_ns = 0;  ///< device time of the first pair after it
+  double step_s = 0.0;    ///< the change of the GPST offset (s)
 };
 
 struct TimeBridgeFit {
   TimeBridge bridge = TimeBridge::gps_clock();
   int pairs = 0;
-  std::vector<int> outlier_lines;  ///< lines of the rejected pairs in the time-sync file
-  double residual_rms_s = 0.0;     ///< of the inliers
-  double max_residual_s = 0.0;     ///< largest inlier residual (absolute)
+  std::vector<int> outlier_lines;   ///< lines of the rejected pairs in the time-sync file
+  double residual_rms_s = 0.0;      ///< of the inliers
+  double max_residual_s = 0.0;      ///< largest inlier residual (absolute)
+  std::vector<TimeSyncStep> steps;  ///< where the pairs were split into pieces
   std::vector<std::string> warnings;
 };
 
-/// Fits the bridge to time-sync pairs (any order). Error if there is none, if all device times are equal, if the
-/// inliers' residual RMS or the drift is beyond the options' limits, or if fewer than half the pairs are inliers.
+/// Fits the bridge to time-sync pairs (any order), in pieces where they step. Error if there is none, if all device
+/// times are equal, or if in a piece the inliers' residual RMS or the drift is beyond the options' limits or fewer
+/// than half the pairs are inliers.
 Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& pairs,
                                       const TimeBridgeOptions& options = {});
 
@@ -101,6 +131,8 @@ class CausalTimeBridge {
   [[nodiscard]] std::uint64_t pairs_received() const { return received_; }
   /// The fit in use (nullopt before the first).
   [[nodiscard]] const std::optional<TimeBridgeFit>& fit() const { return fit_; }
+  /// Steps of the time sync seen so far: a pose mapped after a new one (to_gps) starts a new VIO segment.
+  [[nodiscard]] int steps_seen() const { return steps_seen_; }
 
  private:
   TimeBridgeOptions options_;
@@ -113,6 +145,8 @@ class CausalTimeBridge {
   std::uint64_t fit_first_ = 0;
   std::uint64_t fit_last_ = 0;
   std::optional<Error> fit_error_;
+  int steps_seen_ = 0;
+  std::int64_t last_step_ns_ = 0;
 };
 
 }  // namespace canyon::fusion

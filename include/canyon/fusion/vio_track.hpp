@@ -20,6 +20,10 @@
 // cov(before, first) = P_before; increments inside the new frame keep their variances (dP cancels in them). A gap
 // still starts a new segment (during a gap the device moves unseen), and so does a turn too fast with the position
 // continuous (a frame rotated about anything but the device would move the position too: the device turned).
+// A step of the time sync (time_bridge.hpp: the poses after it are mapped with another piece of the clock fit) is
+// stitched the same way: the frame is the VIO's own, only the poses' times moved, so no increment spans the step and
+// the alignment holds; the device's motion misplaced in time by the step (about its length times the speed) becomes
+// part of F, for the GNSS to correct.
 //
 // Interpolation at time t between samples k and k+1 of one segment, a = (t - t_k) / (t_k+1 - t_k):
 //   T(t) = T_k Exp(a Log(T_k^-1 T_k+1)),   xi(t) = J_T_Tk xi_k + J_T_Tk+1 xi_k+1   (core::se3_interpolate).
@@ -99,7 +103,8 @@ struct VioTrackSample {
   core::Matrix6d P = core::Matrix6d::Zero();
   core::Matrix6d C_previous = core::Matrix6d::Zero();  ///< cov(xi of the previous sample, xi of this one)
   int segment = 0;
-  int line = 0;  ///< in the VIO file
+  int line = 0;         ///< in the VIO file
+  int clock_piece = 0;  ///< the time bridge's piece (or steps seen) that mapped it: a change is a new segment
 };
 
 /// A pose interpolated at one time: T = T_k Exp(a Log(T_k^-1 T_k+1)) with the Jacobians on both samples.
@@ -127,7 +132,7 @@ class VioTrack {
 
   /// Appends the pose of `record` at GPST t, its segment assigned as build() would (a new segment: `note`, if
   /// given, receives why). False, and nothing appended, when t is not after the last pose's time.
-  bool append(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr);
+  bool append(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr, int clock_piece = 0);
   /// Forgets the samples before GPST t except the last one before it (memory of a long live run).
   void forget_before(const core::GpsTime& t);
   /// pose_at(t) is final: a sample after t exists, and when it starts a segment, the one after it too.
@@ -168,7 +173,7 @@ class VioTrack {
 
 /// Why `next` starts a new segment after `previous` (a gap, a jump, a covariance reset), empty if it does not; a gap
 /// is judged against max(options.max_gap_s, kGapIntervals nominal_interval_s); `kind`, if given, receives which.
-enum class SegmentBreak { None, Gap, Jump, Turn, CovarianceReset };
+enum class SegmentBreak { None, Gap, Jump, Turn, CovarianceReset, TimeSyncStep };
 std::string segment_break(const VioTrackSample& previous, const VioTrackSample& next, const VioTrackOptions& options,
                           double nominal_interval_s = 0.0, SegmentBreak* kind = nullptr);
 
