@@ -25,6 +25,7 @@ std::string VioTrackOptions::validate() const {
   }
   if (!(extrapolation_s >= 0.0)) return "extrapolation_s must be >= 0";
   if (!(interpolation_accel_mps2 >= 0.0)) return "interpolation_accel_mps2 must be >= 0";
+  if (!(max_bridged_gap_s >= 0.0)) return "max_bridged_gap_s must be >= 0";
   return {};
 }
 
@@ -89,6 +90,16 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
 
 namespace {
 
+/// A gap the stream comes back from in the same frame (see the top of vio_track.hpp): short enough, no faster than
+/// max_speed_mps, no covariance collapse.
+bool bridgeable_gap(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options, double dt_s) {
+  if (!(dt_s <= options.max_bridged_gap_s)) return false;
+  if ((s.T_OI.p - prev.T_OI.p).norm() > options.max_speed_mps * dt_s) return false;
+  const double trace = s.P.topLeftCorner<3, 3>().trace();
+  const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
+  return !(prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace);
+}
+
 /// Stitches `s`, the first pose after a jump or reset, to `prev` (and `before_prev`, if of its segment, for the
 /// extrapolation): `stitch` then maps every later pose of the new frame (see the top of vio_track.hpp).
 void stitch_to(const VioTrackSample* before_prev, const VioTrackSample& prev, VioTrackSample& s,
@@ -144,6 +155,15 @@ void place_in_segment(const VioTrackSample* before_prev, const VioTrackSample* p
     return;
   }
   const std::string where = " at " + core::format_gpst(reference + s.t_s, 3) + " (line " + std::to_string(s.line) + ")";
+  if (kind == SegmentBreak::Gap && bridgeable_gap(*judged, s, options, dt_s)) {
+    if (stitch.count > 0) {
+      s.T_OI = stitch.F * s.T_OI;
+      s.P += stitch.dP;
+    }
+    s.C_previous.setZero();  // the poses either side taken as uncorrelated
+    if (note != nullptr) *note = why + where + ": bridged, the alignment kept (the same frame after it)";
+    return;
+  }
   // A jump or reset moved the VIO's frame; a time-sync step moved its poses in time (the frame is the same): either
   // way the device did not move, and the poses after it are stitched to the ones before.
   const bool stitchable =

@@ -171,10 +171,17 @@ std::vector<VioTrackSample> straight_samples(int n, double dt_s, double speed_mp
   return s;
 }
 
+/// Options under which every gap starts a segment (no bridging): the gap rules themselves.
+VioTrackOptions unbridged() {
+  VioTrackOptions o;
+  o.max_bridged_gap_s = 0.0;
+  return o;
+}
+
 /// The samples appended one by one to a streaming track (each append must succeed), the segment notes in `notes`.
-VioTrack streamed(const std::vector<VioTrackSample>& samples, const core::GpsTime& ref,
-                  std::vector<std::string>& notes) {
-  VioTrack live = VioTrack::streaming({});
+VioTrack streamed(const std::vector<VioTrackSample>& samples, const core::GpsTime& ref, std::vector<std::string>& notes,
+                  const VioTrackOptions& options = {}) {
+  VioTrack live = VioTrack::streaming(options);
   for (const VioTrackSample& v : samples) {
     io::VioRecord r;
     r.T_OI = v.T_OI;
@@ -197,11 +204,11 @@ TEST(VioTrackTest, GapsAreJudgedAgainstTheStreamsOwnRate) {
     EXPECT_EQ(VioTrack::from_samples(s, ref).segments(), 1) << dt_s;
     EXPECT_NEAR(median_interval_s(s), dt_s, 1e-12);
     for (std::size_t k = 30; k < s.size(); ++k) s[k].t_s += 4.0 * dt_s;  // 5 intervals: a gap
-    const VioTrack whole = VioTrack::from_samples(s, ref);
+    const VioTrack whole = VioTrack::from_samples(s, ref, unbridged());
     EXPECT_EQ(whole.segments(), 2) << dt_s;
     EXPECT_EQ(whole.samples()[30].segment, 1);
     std::vector<std::string> notes;
-    const VioTrack live = streamed(s, ref, notes);
+    const VioTrack live = streamed(s, ref, notes, unbridged());
     EXPECT_EQ(live.segments(), 2);
     ASSERT_EQ(notes.size(), 1U);
     EXPECT_NE(notes[0].find("VIO gap of"), std::string::npos) << notes[0];
@@ -210,9 +217,9 @@ TEST(VioTrackTest, GapsAreJudgedAgainstTheStreamsOwnRate) {
   }
   std::vector<VioTrackSample> fast = straight_samples(60, 0.1, 1.4);
   for (std::size_t k = 30; k < fast.size(); ++k) fast[k].t_s += 0.35;  // 0.45 s: under vio_max_gap_s (0.5 s)
-  EXPECT_EQ(VioTrack::from_samples(fast, ref).segments(), 1);
+  EXPECT_EQ(VioTrack::from_samples(fast, ref, unbridged()).segments(), 1);
   for (std::size_t k = 40; k < fast.size(); ++k) fast[k].t_s += 0.5;  // 0.6 s: a gap
-  EXPECT_EQ(VioTrack::from_samples(fast, ref).segments(), 2);
+  EXPECT_EQ(VioTrack::from_samples(fast, ref, unbridged()).segments(), 2);
   // A stream that slows from 10 Hz to 1 Hz: gaps until the median follows, then one segment again.
   std::vector<VioTrackSample> slowing = straight_samples(100, 0.1, 1.4);
   for (std::size_t k = 50; k < slowing.size(); ++k) slowing[k].t_s = slowing[49].t_s + (k - 49.0);
@@ -278,7 +285,7 @@ TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   for (int k = 20; k < 40; ++k) s[static_cast<std::size_t>(k)].T_OI.p.x() += 100.0;  // a 100 m jump at sample 20
   for (int k = 30; k < 40; ++k) s[static_cast<std::size_t>(k)].P *= 1e-4;            // a covariance reset at 30
   const core::GpsTime ref{2266, 100.0};
-  VioTrackOptions unstitched;
+  VioTrackOptions unstitched = unbridged();
   unstitched.stitch_frame_resets = false;
   const VioTrack track = VioTrack::from_samples(s, ref, unstitched);
   EXPECT_EQ(track.segments(), 4);
@@ -367,7 +374,45 @@ TEST(VioTrackTest, StitchesJumpsAndResetsButNotGapsOrTurns) {
     turned[static_cast<std::size_t>(k)].T_OI.q = turn.q * s[static_cast<std::size_t>(k)].T_OI.q;
   }
   for (int k = 40; k < 60; ++k) turned[static_cast<std::size_t>(k)].t_s += 1.0;
-  EXPECT_EQ(VioTrack::from_samples(turned, ref).segments(), 3);
+  EXPECT_EQ(VioTrack::from_samples(turned, ref, unbridged()).segments(), 3);
+}
+
+// A stream that stops and comes back in the same frame keeps its segment (and so the alignment) up to
+// max_bridged_gap_s; a longer gap, a faster-than-possible move or a covariance collapse across it is a new segment.
+TEST(VioTrackTest, AGapInTheSameFrameIsBridgedWithUncorrelatedEnds) {
+  const core::GpsTime ref{2266, 100.0};
+  std::vector<VioTrackSample> s = straight_samples(60, 0.1, 1.4);
+  for (int k = 1; k < 60; ++k) s[static_cast<std::size_t>(k)].C_previous = s[static_cast<std::size_t>(k - 1)].P;
+  for (int k = 30; k < 60; ++k) {  // 30 s unseen, walked on at 1.4 m/s
+    s[static_cast<std::size_t>(k)].t_s += 29.9;
+    s[static_cast<std::size_t>(k)].T_OI.p.x() += 1.4 * 29.9;
+  }
+  std::vector<std::string> notes;
+  const VioTrack whole = VioTrack::from_samples(s, ref);
+  const VioTrack live = streamed(s, ref, notes);
+  for (const VioTrack* track : {&whole, &live}) {
+    EXPECT_EQ(track->segments(), 1);
+    EXPECT_TRUE(track->samples()[30].C_previous.isZero());
+    EXPECT_LT((track->samples()[30].T_OI.p - s[30].T_OI.p).norm(), 1e-12);  // as given: no stitch
+  }
+  ASSERT_EQ(notes.size(), 1U);
+  EXPECT_NE(notes[0].find("VIO gap of 30.00 s"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("bridged"), std::string::npos) << notes[0];
+  // The increment across the gap: both poses' covariances.
+  const auto a = whole.pose_at(ref + 2.9), b = whole.pose_at(ref + 32.9);
+  ASSERT_TRUE(a && b);
+  const Matrix12d J = whole.joint_covariance(*a, *b);
+  EXPECT_NEAR(J(0, 0) + J(6, 6) - 2.0 * J(0, 6), s[29].P(0, 0) + s[30].P(0, 0), 1e-12);
+  // A longer gap than max_bridged_gap_s, a move faster than max_speed_mps, a covariance collapse: new segments.
+  VioTrackOptions short_bridge;
+  short_bridge.max_bridged_gap_s = 20.0;
+  EXPECT_EQ(VioTrack::from_samples(s, ref, short_bridge).segments(), 2);
+  std::vector<VioTrackSample> far = s;
+  for (int k = 30; k < 60; ++k) far[static_cast<std::size_t>(k)].T_OI.p.x() += 1000.0;
+  EXPECT_EQ(VioTrack::from_samples(far, ref).segments(), 2);
+  std::vector<VioTrackSample> reset = s;
+  for (int k = 30; k < 60; ++k) reset[static_cast<std::size_t>(k)].P *= 1e-4;
+  EXPECT_EQ(VioTrack::from_samples(reset, ref).segments(), 2);
 }
 
 TEST(CausalTimeBridgeTest, MapsWithThePairsOlderThanTheHoldOnlyAndOnlyOnceTheyAreIn) {

@@ -10,6 +10,13 @@
 // reset_covariance_ratio times the previous one's: the VIO restarted its covariance with its frame). T_EO belongs to
 // one segment; the fusion re-aligns in a new one.
 //
+// Bridged gaps (max_bridged_gap_s, beyond the paper). A stream that stops and comes back in the same frame (a dropped
+// link, a paused publisher) keeps its alignment: a gap up to max_bridged_gap_s after which the pose moved no faster
+// than max_speed_mps and the covariance did not collapse stays in its segment. The poses either side are taken as
+// uncorrelated (the increment across the gap gets both covariances) and the GNSS epochs inside it get the
+// interpolation's error (interpolation_accel_mps2 over the whole gap: metres to hundreds of metres, no information).
+// A VIO that restarted in a new frame after the gap shows it by a jump or a covariance reset (stitched, below).
+//
 // Stitching (stitch_frame_resets, beyond the paper). A jump (in position) or a covariance reset moves the VIO's
 // odometry frame, not
 // the device, whose pose is continuous over one pose interval: the poses from there on are mapped back into the
@@ -70,6 +77,7 @@ struct VioTrackOptions {
   /// poses in different intervals are taken as independent. 0: interpolation taken as exact.
   double interpolation_accel_mps2 = 1.0;
   bool stitch_frame_resets = true;  ///< map a jump's or reset's new frame back into the old one (above)
+  double max_bridged_gap_s = 60.0;  ///< a longer gap is a new segment; a shorter one in the same frame is bridged (s)
 
   [[nodiscard]] std::string validate() const;
 };
