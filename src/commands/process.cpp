@@ -351,15 +351,19 @@ Result<fusion::VioTrack> load_vio_causal(const config::ProcessConfig& config, co
   fusion::VioTrack track = fusion::VioTrack::streaming(config.fusion.vio);
   std::vector<std::string> notes;
   int unmapped = 0;
+  int unmapped_run = 0;
   for (const io::VioRecord& record : vio.records) {
     auto t = bridge.to_gps(record.t_ns);
     if (!t) {
-      if (unmapped++ == 0) {
+      // The first pose of each run of unmapped ones says why.
+      if (unmapped_run++ == 0) {
         summary.report.push_back("fusion: " + config.vio + ":" + std::to_string(record.line) +
                                  ": pose not mapped to GPST: " + t.error().message);
       }
+      ++unmapped;
       continue;
     }
+    unmapped_run = 0;
     std::string note;
     // A fit cannot reorder poses a few ms apart; after a time-sync step back in GPST the first poses are dropped.
     (void)track.append(record, *t, &note, bridge.steps_seen());
@@ -367,7 +371,11 @@ Result<fusion::VioTrack> load_vio_causal(const config::ProcessConfig& config, co
   }
   if (unmapped > 0) {
     summary.report.push_back("fusion: " + std::to_string(unmapped) +
-                             " VIO poses before the causal time bridge had its pairs (not used)");
+                             " VIO poses not mapped to GPST by the causal time bridge (not used; why above)");
+  }
+  if (bridge.ignored_steps() > 0) {
+    summary.report.push_back("fusion: " + bridge.ignored_step_note() + " (" + std::to_string(bridge.ignored_steps()) +
+                             " such step(s))");
   }
   if (track.empty()) return Error{"no VIO pose mapped to GPST by the causal time bridge", config.vio, 0};
   report_vio_segments(track, config.fusion.vio, notes, summary);

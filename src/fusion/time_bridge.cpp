@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "canyon/core/statistics.hpp"
 
@@ -14,6 +15,7 @@ namespace {
 constexpr int kMaxIterations = 20;
 constexpr double kMadToSigma = 1.4826;
 constexpr std::int64_t kNsPerWeek = std::int64_t{core::kSecondsPerWeek} * 1000000000;
+constexpr std::int64_t kStampWindowNs = 30'000'000'000;  // the poses' stamps the causal bridge keeps (ns)
 
 /// The median of a copy: the callers keep their vectors' order.
 double median(std::vector<double> v) {
@@ -47,6 +49,52 @@ core::GpsTime TimeBridge::to_gps(std::int64_t t_ns) const {
   const Piece& piece = pieces_[static_cast<std::size_t>(piece_of(t_ns))];
   const double x_s = static_cast<double>(t_ns - reference_ns_) * 1e-9;
   return reference_time_ + (piece.a_s + piece.b * x_s);
+}
+
+double TimeBridge::step_s(int k, int from) const {
+  const Piece& to = piece(k);
+  const Piece& before = piece(from);
+  const double x_s = static_cast<double>(to.from_ns - reference_ns_) * 1e-9;
+  return (to.a_s + to.b * x_s) - (before.a_s + before.b * x_s);
+}
+
+std::optional<std::int64_t> vio_clock_shows_step(const std::vector<std::int64_t>& stamps_ns, std::int64_t after_ns,
+                                                 std::int64_t from_ns, double step_s) {
+  if (stamps_ns.size() < 3) return std::nullopt;
+  std::vector<double> intervals_s;
+  for (std::size_t i = 1; i < stamps_ns.size(); ++i) {
+    intervals_s.push_back(static_cast<double>(stamps_ns[i] - stamps_ns[i - 1]) * 1e-9);
+  }
+  const double nominal_s = median(intervals_s);
+  // The device clock's step lies between the pairs either side of the time sync's; one interval of slack each side.
+  const auto slack_ns = static_cast<std::int64_t>(std::llround(nominal_s * 1e9));
+  for (std::size_t i = 1; i < stamps_ns.size(); ++i) {
+    if (stamps_ns[i] < after_ns - slack_ns || stamps_ns[i - 1] > from_ns + slack_ns) continue;
+    const double jump_s = intervals_s[i - 1] - nominal_s;
+    if (std::abs(jump_s + step_s) < 0.5 * std::abs(step_s)) return stamps_ns[i];
+  }
+  return std::nullopt;
+}
+
+std::vector<VioClockLine> lines_the_vio_follows(const TimeBridge& bridge, const std::vector<std::int64_t>& stamps_ns) {
+  std::vector<VioClockLine> lines{VioClockLine{std::numeric_limits<std::int64_t>::min(), 0}};
+  int line = 0;  // the piece whose line the VIO's clock follows
+  for (int k = 1; k < bridge.pieces(); ++k) {
+    const double back_s = bridge.step_s(k, line);
+    const double step_s = bridge.step_s(k, k - 1);
+    const std::optional<std::int64_t> shown =
+        vio_clock_shows_step(stamps_ns, bridge.piece(k).after_ns, bridge.piece(k).from_ns, back_s);
+    const bool back = std::abs(back_s) < 0.5 * std::abs(step_s);  // closer to the followed line than this step
+    if (shown || back) line = k;
+    lines.push_back(VioClockLine{shown ? std::min(*shown, bridge.piece(k).from_ns) : bridge.piece(k).from_ns, line});
+  }
+  return lines;
+}
+
+core::GpsTime TimeBridge::to_gps_with_piece(std::int64_t t_ns, int k) const {
+  const Piece& p = piece(std::max(k, 0));
+  const double x_s = static_cast<double>(t_ns - reference_ns_) * 1e-9;
+  return reference_time_ + (p.a_s + p.b * x_s);
 }
 
 int TimeBridge::piece_of(std::int64_t t_ns) const {
@@ -235,7 +283,7 @@ Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& input
       fit.max_residual_s = std::max(fit.max_residual_s, r);
       ++inliers;
     }
-    map.push_back(TimeBridge::Piece{pairs[begin].t_ns, line.a, line.b});
+    map.push_back(TimeBridge::Piece{pairs[begin].t_ns, line.a, line.b, begin > 0 ? pairs[begin - 1].t_ns : 0});
     if (k > 0) {
       const double step_s = (line.a + line.b * x[begin]) - (lines[k - 1].a + lines[k - 1].b * x[begin]);
       fit.steps.push_back(TimeSyncStep{pairs[begin - 1].line, pairs[begin].line, pairs[begin].t_ns, step_s});
@@ -247,8 +295,8 @@ Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& input
     char text[240];
     std::snprintf(text, sizeof text,
                   "the GPST of the device clock steps by %+.3f s between the pairs at lines %d and %d: fitted in "
-                  "pieces; the VIO poses after it are stitched to those before (vio_stitch_resets) or start a new "
-                  "segment",
+                  "pieces; the VIO takes the new piece if its own stamps step too (the device clock stepped), else "
+                  "it keeps the line before (the time sync alone stepped)",
                   step.step_s, step.line_before, step.line_after);
     fit.warnings.emplace_back(text);
   }
@@ -279,6 +327,8 @@ bool CausalTimeBridge::ready(std::int64_t t_ns) const {
 
 Result<core::GpsTime> CausalTimeBridge::to_gps(std::int64_t t_ns) {
   if (gps_clock_) return TimeBridge::gps_clock().to_gps(t_ns);
+  recent_stamps_ns_.push_back(t_ns);
+  while (t_ns - recent_stamps_ns_.front() > kStampWindowNs) recent_stamps_ns_.pop_front();
   const auto hold_ns = static_cast<std::int64_t>(std::llround(options_.causal_hold_s * 1e9));
   const std::int64_t cutoff_ns = t_ns - hold_ns;
   // The pairs at or before the cutoff: [0, end) of pairs_; the fit takes the last window of them.
@@ -310,11 +360,35 @@ Result<core::GpsTime> CausalTimeBridge::to_gps(std::int64_t t_ns) {
     }
   }
   if (fit_error_) return *fit_error_;
-  if (!fit_->steps.empty() && fit_->steps.back().t_ns > last_step_ns_) {
-    ++steps_seen_;
-    last_step_ns_ = fit_->steps.back().t_ns;
+  const TimeBridge& bridge = fit_->bridge;
+  if (bridge.pieces() > 1 && bridge.piece(bridge.pieces() - 1).from_ns > last_step_ns_) {
+    // A new step: the device clock's (the poses' stamps show it: stitched) or the time sync's alone (refused).
+    const int k = bridge.pieces() - 1;
+    last_step_ns_ = bridge.piece(k).from_ns;
+    const double step_s = bridge.step_s(k, k - 1);
+    const std::vector<std::int64_t> stamps(recent_stamps_ns_.begin(), recent_stamps_ns_.end());
+    if (followed_) {
+      // Keeping a line already: this step may come back to it (below).
+    } else if (vio_clock_shows_step(stamps, bridge.piece(k).after_ns, bridge.piece(k).from_ns, step_s).has_value()) {
+      ++steps_seen_;
+    } else {
+      followed_ = TimeBridge(bridge.reference_ns(), bridge.reference_time(), {bridge.piece(k - 1)});
+      ++ignored_steps_;
+      char text[240];
+      std::snprintf(text, sizeof text,
+                    "the time sync stepped by %+.3f s at device time %.3f s but the VIO's own clock did not: the VIO "
+                    "keeps the mapping before it until the sync comes back",
+                    step_s, static_cast<double>(bridge.piece(k).from_ns) * 1e-9);
+      ignored_note_ = text;
+    }
   }
-  return fit_->bridge.to_gps(t_ns);
+  const core::GpsTime t = bridge.to_gps(t_ns);
+  if (followed_) {
+    const core::GpsTime kept = followed_->to_gps(t_ns);
+    if (std::abs(t - kept) > options_.max_residual_rms_s) return kept;
+    followed_.reset();  // the sync came back to the line the VIO follows
+  }
+  return t;
 }
 
 }  // namespace canyon::fusion

@@ -203,11 +203,21 @@ Result<VioTrack> VioTrack::build(const io::VioFile& file, const TimeBridge& brid
   const core::GpsTime reference = bridge.to_gps(file.records.front().t_ns);
   std::vector<VioTrackSample> samples;
   samples.reserve(file.records.size());
+  std::vector<std::int64_t> stamps_ns;
+  stamps_ns.reserve(file.records.size());
+  for (const io::VioRecord& r : file.records) stamps_ns.push_back(r.t_ns);
+  // After a step of the time sync that the VIO's own stamps do not show, the poses keep the line before it.
+  const std::vector<VioClockLine> lines = lines_the_vio_follows(bridge, stamps_ns);
   int overlapped = 0;
+  int kept_line = 0;
+  std::size_t line = 0;
   for (const io::VioRecord& r : file.records) {
     VioTrackSample s;
-    s.t_s = bridge.to_gps(r.t_ns) - reference;
-    s.clock_piece = bridge.piece_of(r.t_ns);
+    while (line + 1 < lines.size() && lines[line + 1].from_ns <= r.t_ns) ++line;
+    const int piece = bridge.piece_of(r.t_ns);
+    s.clock_piece = lines[line].piece;
+    s.t_s = bridge.to_gps_with_piece(r.t_ns, s.clock_piece) - reference;
+    if (s.clock_piece < piece) ++kept_line;
     // A clock fit cannot reorder poses, but after a time-sync step back in GPST the next piece's first poses fall
     // before the last ones mapped: those are left out.
     if (!samples.empty() && !(s.t_s > samples.back().t_s)) {
@@ -221,6 +231,11 @@ Result<VioTrack> VioTrack::build(const io::VioFile& file, const TimeBridge& brid
     samples.push_back(s);
   }
   assign_segments(samples, options, reference, &notes);
+  if (kept_line > 0) {
+    notes.push_back(std::to_string(kept_line) +
+                    " VIO poses after a step of the time sync that the VIO's own clock does not show: mapped with the "
+                    "line before it (the time sync alone stepped)");
+  }
   if (overlapped > 0) {
     notes.push_back(std::to_string(overlapped) +
                     " VIO poses mapped to GPST no later than the pose before them (after a time-sync step): left out");

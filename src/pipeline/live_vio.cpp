@@ -76,6 +76,10 @@ void LiveVio::map_ready() {
   while (!pending_.empty() && bridge_.ready(pending_.front().t_ns)) {
     const io::VioRecord& pose = pending_.front();
     auto t = bridge_.to_gps(pose.t_ns);
+    if (bridge_.ignored_steps() > ignored_steps_reported_) {
+      ignored_steps_reported_ = bridge_.ignored_steps();
+      if (warn_) warn_(bridge_.ignored_step_note());
+    }
     if (!t) {
       warn_once(unmapped_.fetch_add(1) + 1, "VIO pose at device time " + std::to_string(pose.t_ns) +
                                                 " ns not mapped to GPST: " + t.error().message);

@@ -73,7 +73,7 @@ for seed in $seeds; do
       sync-step) r=$(score "$c" "$c/vio.csv" "$d/sync-step.csv" "$d/r-$input"); what="time sync 1 s step" ;;
     esac
     read -r correct wrong last <<<"$r"
-    said=$(grep -m1 -oE "VIO (gap|jump|covariance reset)[^:]*" "$d/r-$input.log" || true)
+    said=$(grep -m1 -oE "VIO (gap|jump|covariance reset)[^:]*|device clock steps by [^:]*" "$d/r-$input.log" || true)
     [[ -n $said ]] || said=$(grep -m1 -oE "error: .*" "$d/r-$input.log" || true)
     printf '%-14s %5s %-24s %9s %6s %12s  %s\n' "$scenario" "$seed" "$what" "$correct" "$wrong" "$last" "${said:-}"
     if [[ $wrong != "$clean_wrong" && $wrong != 0 ]]; then failed=1; fi

@@ -305,33 +305,46 @@ TEST(VioTrackTest, InterpolatesOnSe3AndSplitsSegmentsAtGapsJumpsAndResets) {
   EXPECT_FALSE(track.pose_at(ref + 100.0).has_value());  // after the last
 }
 
-TEST(VioTrackTest, ATimeSyncStepIsStitchedAndThePosesItMapsBeforeTheLastAreLeftOut) {
-  // Poses every 0.1 s of a straight walk at 1.4 m/s (device time = GPST from ref); from device time 5 s on the time
-  // bridge maps 1 s earlier (a second piece). Poses at device 5.0-5.9 s map to GPST 4.0-4.9 s, not after the last
-  // one: left out; the one at 6.0 s (GPST 5.0 s) is the first after the step, stitched to the pose before.
+TEST(VioTrackTest, ATimeSyncStepTheVioClockShowsIsStitchedOneItDoesNotShowKeepsTheLine) {
+  // Poses every 0.1 s of a straight walk at 1.4 m/s; the time bridge's second piece, from the pair at device time 6 s
+  // (the one before at 5 s), maps 1 s earlier: the same GPST comes with a device time 1 s later.
   const core::GpsTime ref{2266, 100.0};
-  io::VioFile file;
   const std::vector<VioTrackSample> s = straight_samples(101, 0.1, 1.4);
-  for (const VioTrackSample& v : s) {
-    file.records.push_back(io::VioRecord{std::llround(v.t_s * 1e9), v.T_OI, v.P, std::nullopt, v.line});
-  }
-  const TimeBridge bridge(0, ref, {TimeBridge::Piece{0, 0.0, 1.0}, TimeBridge::Piece{5'000'000'000, -1.0, 1.0}});
+  const TimeBridge bridge(0, ref,
+                          {TimeBridge::Piece{0, 0.0, 1.0}, TimeBridge::Piece{6'000'000'000, -1.0, 1.0, 5'000'000'000}});
+  const auto file_with = [&](bool clock_stepped) {
+    io::VioFile file;
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      // The device clock stepped at 5.05 s: the poses' own stamps are 1 s later from there (or the sync alone did).
+      const double device_s = s[k].t_s + (clock_stepped && k >= 51 ? 1.0 : 0.0);
+      file.records.push_back(io::VioRecord{std::llround(device_s * 1e9), s[k].T_OI, s[k].P, std::nullopt, s[k].line});
+    }
+    return file;
+  };
   for (const bool stitch : {true, false}) {
-    VioTrackOptions options;
+    VioTrackOptions options = unbridged();
     options.stitch_frame_resets = stitch;
+    // The device clock stepped: from its step on the poses take the new piece, in time as the walk was; the track
+    // breaks there (stitched, or a new segment).
     std::vector<std::string> notes;
-    auto track = VioTrack::build(file, bridge, options, notes);
+    auto track = VioTrack::build(file_with(true), bridge, options, notes);
     ASSERT_TRUE(track.ok());
-    EXPECT_EQ(track->samples().size(), 91U);  // 10 left out
+    EXPECT_EQ(track->samples().size(), 101U);
     EXPECT_EQ(track->segments(), stitch ? 1 : 2);
-    ASSERT_EQ(notes.size(), 2U);
+    for (std::size_t k = 0; k < 101; ++k) EXPECT_NEAR(track->samples()[k].t_s, s[k].t_s, 1e-6) << k;
+    ASSERT_EQ(notes.size(), 1U);
     EXPECT_NE(notes[0].find("VIO time-sync step"), std::string::npos) << notes[0];
     EXPECT_NE(notes[0].find(stitch ? "stitched" : "new VIO segment"), std::string::npos) << notes[0];
-    EXPECT_NE(notes[1].find("10 VIO poses"), std::string::npos) << notes[1];
-    const VioTrackSample& first_after = track->samples()[50];
-    EXPECT_NEAR(first_after.t_s, 5.0, 1e-9);
-    // Stitched: continuous with the pose at 4.9 s (6.86 m) moved on by one interval; as given: 8.4 m.
-    EXPECT_NEAR(first_after.T_OI.p.x(), stitch ? 7.0 : 8.4, 1e-4);  // SE(3) extrapolation of a slow turn
+    // The time sync alone stepped: the poses keep the line before it, one segment, said once.
+    notes.clear();
+    track = VioTrack::build(file_with(false), bridge, options, notes);
+    ASSERT_TRUE(track.ok());
+    EXPECT_EQ(track->segments(), 1);
+    for (std::size_t k = 0; k < 101; ++k) EXPECT_NEAR(track->samples()[k].t_s, s[k].t_s, 1e-6) << k;
+    ASSERT_EQ(notes.size(), 1U);
+    EXPECT_NE(notes[0].find("41 VIO poses after a step of the time sync that the VIO's own clock does not show"),
+              std::string::npos)
+        << notes[0];
   }
 }
 
@@ -453,24 +466,32 @@ TEST(CausalTimeBridgeTest, MapsWithThePairsOlderThanTheHoldOnlyAndOnlyOnceTheyAr
     EXPECT_EQ(*got - expected->bridge.to_gps(t_ns), 0.0) << t_s;
     EXPECT_LT(std::abs(*got - (start + t_s)), 3e-3) << t_s;
   }
-  // A step (the same GPST with a device time 1 s later from pair 20 on): mapped with the old line until five pairs
-  // after it are old enough to use, then with the new piece, the step counted once.
+  // A step (the same GPST with a device time 1 s later from pair 20 on), poses every 0.1 s. If the poses' own stamps
+  // step too (the device clock stepped), they take the new piece once five pairs after the step are old enough to
+  // use (before that the old line places them 1 s late), the step counted once; if they do not (the time sync alone
+  // stepped), they keep the old line, the step said and not counted.
   TimeBridgeOptions wide = options;
   wide.causal_window_pairs = 30;
-  CausalTimeBridge stepped(wide);
   const auto stepped_ns = [&](double t_s) { return device_ns(t_s) + (t_s >= 19.5 ? 1'000'000'000 : 0); };
-  for (int k = 0; k < 40; ++k) ASSERT_TRUE(stepped.add(io::TimeSyncPair{stepped_ns(k), start + k, k + 2}).ok());
-  for (const double t_s : {10.0, 21.0, 24.0}) {
-    auto got = stepped.to_gps(stepped_ns(t_s));
-    ASSERT_TRUE(got.ok()) << t_s;
-    EXPECT_EQ(stepped.steps_seen(), 0) << t_s;
-    EXPECT_NEAR(*got - (start + t_s), t_s >= 19.5 ? 1.0 : 0.0, 3e-3) << t_s;  // the old line: 1 s late
-  }
-  for (const double t_s : {26.0, 30.0, 38.0}) {
-    auto got = stepped.to_gps(stepped_ns(t_s));
-    ASSERT_TRUE(got.ok()) << t_s;
-    EXPECT_EQ(stepped.steps_seen(), 1) << t_s;
-    EXPECT_LT(std::abs(*got - (start + t_s)), 3e-3) << t_s;
+  for (const bool clock_stepped : {true, false}) {
+    CausalTimeBridge stepped(wide);
+    for (int k = 0; k < 40; ++k) ASSERT_TRUE(stepped.add(io::TimeSyncPair{stepped_ns(k), start + k, k + 2}).ok());
+    for (int i = 0; i <= 280; ++i) {
+      const double t_s = 10.0 + 0.1 * i;
+      auto got = stepped.to_gps(clock_stepped ? stepped_ns(t_s) : device_ns(t_s));
+      ASSERT_TRUE(got.ok()) << t_s;
+      const bool late = clock_stepped && t_s >= 19.5 && t_s < 25.45;  // the new piece not seen yet
+      if (t_s < 19.5 || t_s >= 25.45 || !clock_stepped) {
+        EXPECT_LT(std::abs(*got - (start + t_s)), 3e-3) << t_s << (clock_stepped ? " clock stepped" : " sync alone");
+      } else if (late) {
+        EXPECT_GT(*got - (start + t_s), 0.9) << t_s;
+      }
+    }
+    EXPECT_EQ(stepped.steps_seen(), clock_stepped ? 1 : 0);
+    EXPECT_EQ(stepped.ignored_steps(), clock_stepped ? 0 : 1);
+    if (!clock_stepped) {
+      EXPECT_NE(stepped.ignored_step_note().find("the VIO's own clock did not"), std::string::npos);
+    }
   }
   CausalTimeBridge gps = CausalTimeBridge::gps_clock();
   EXPECT_TRUE(gps.ready(0));

@@ -15,9 +15,12 @@
 // y - x changes at once and stays changed. A step is where consecutive pairs' offsets differ by more than
 // max_residual_rms_s and the median offsets of up to 9 pairs on each side (at least 5 after it) differ by as much (a
 // few outlier pairs are no step). The pairs are then fitted in pieces, one per stretch between steps (a piece of one
-// pair takes the drift of the longest piece), each pose is mapped with the piece its device time falls in, and the
-// VIO track breaks at each step (vio_track.hpp: the poses after it are stitched to those before, as after a frame
-// reset, or start a new segment): the two pieces cannot both be right about the poses, so no increment spans it.
+// pair takes the drift of the longest piece). Which piece maps a pose is the VIO's own clock's call: if its stamps
+// step too at the same place (an interval off its rate by about the step: the device clock stepped), the poses from
+// there take the new piece and the VIO track breaks (vio_track.hpp: stitched, as after a frame reset, or a new
+// segment); if they do not, the time sync alone stepped (a receiver glitch, a restarted sync) and the poses keep the
+// line they followed until a later piece comes back to it. The causal bridge does the same with the stamps of the
+// poses it mapped in the last 30 s, once the step is seen (five pairs after it).
 // One pair determines the offset only: b = 1 (drift taken as zero), with a warning. VIO already on GPST (t_ns =
 // GPST nanoseconds since 1980-01-06 00:00:00) needs no pairs: TimeBridge::gps_clock().
 //
@@ -58,11 +61,13 @@ struct TimeBridgeOptions {
 /// Device clock -> GPST: one line, or one line per piece between the steps of the time sync.
 class TimeBridge {
  public:
-  /// One line of the map, used from device time from_ns on (the first piece also before it).
+  /// One line of the map, used from device time from_ns on (the first piece also before it); after_ns: the device
+  /// time of the previous piece's last pair (the step happened in (after_ns, from_ns]).
   struct Piece {
     std::int64_t from_ns = 0;
     double a_s = 0.0;
     double b = 1.0;
+    std::int64_t after_ns = 0;
   };
   /// The identity for VIO stamped with GPST nanoseconds since the GPS epoch.
   static TimeBridge gps_clock();
@@ -73,14 +78,21 @@ class TimeBridge {
       : reference_ns_(reference_ns), reference_time_(reference_time), pieces_(std::move(pieces)) {}
 
   [[nodiscard]] core::GpsTime to_gps(std::int64_t t_ns) const;
+  /// t_ns mapped by piece k, wherever t_ns lies.
+  [[nodiscard]] core::GpsTime to_gps_with_piece(std::int64_t t_ns, int k) const;
   /// The piece that maps t_ns (0 with one piece).
   [[nodiscard]] int piece_of(std::int64_t t_ns) const;
   [[nodiscard]] int pieces() const { return static_cast<int>(pieces_.size()); }
+  [[nodiscard]] const Piece& piece(int k) const { return pieces_[static_cast<std::size_t>(k)]; }
+  /// GPST by piece k minus GPST by piece `from` at piece k's first pair (s).
+  [[nodiscard]] double step_s(int k, int from) const;
   /// Of the first piece.
   [[nodiscard]] double offset_s() const { return gps_clock_ ? 0.0 : pieces_.front().a_s; }
   /// Device clock rate error: the device runs fast by this (1e-6), of the first piece.
   [[nodiscard]] double drift_ppm() const { return gps_clock_ ? 0.0 : (1.0 / pieces_.front().b - 1.0) * 1e6; }
   [[nodiscard]] bool is_gps_clock() const { return gps_clock_; }
+  [[nodiscard]] std::int64_t reference_ns() const { return reference_ns_; }
+  [[nodiscard]] const core::GpsTime& reference_time() const { return reference_time_; }
 
  private:
   TimeBridge() = default;
@@ -108,6 +120,24 @@ struct TimeBridgeFit {
   std::vector<std::string> warnings;
 };
 
+/// Whether a VIO stream's own stamps (device ns, increasing) show a step of the time sync between after_ns and from_ns:
+/// two consecutive stamps there whose interval differs from the stream's nominal one by about -step_s (within half of
+/// it). Then the device clock stepped, and the pieces map the poses right; otherwise only the time sync stepped and
+/// which side of it is right cannot be told.
+/// Returns the stamp after that interval (where the device clock's step is), if any.
+std::optional<std::int64_t> vio_clock_shows_step(const std::vector<std::int64_t>& stamps_ns, std::int64_t after_ns,
+                                                 std::int64_t from_ns, double step_s);
+
+/// The line a VIO stream with these stamps follows from device time from_ns on: piece k's own when the VIO's stamps
+/// show its step (the device clock stepped; from the VIO's own step on) or when it comes back to the line the VIO
+/// followed before; else that line (the time sync alone stepped, and the VIO's clock, which did not, keeps it).
+struct VioClockLine {
+  std::int64_t from_ns = 0;
+  int piece = 0;
+};
+/// One per piece of `bridge`, in device-time order.
+std::vector<VioClockLine> lines_the_vio_follows(const TimeBridge& bridge, const std::vector<std::int64_t>& stamps_ns);
+
 /// Fits the bridge to time-sync pairs (any order), in pieces where they step. Error if there is none, if all device
 /// times are equal, or if in a piece the inliers' residual RMS or the drift is beyond the options' limits or fewer
 /// than half the pairs are inliers.
@@ -131,8 +161,12 @@ class CausalTimeBridge {
   [[nodiscard]] std::uint64_t pairs_received() const { return received_; }
   /// The fit in use (nullopt before the first).
   [[nodiscard]] const std::optional<TimeBridgeFit>& fit() const { return fit_; }
-  /// Steps of the time sync seen so far: a pose mapped after a new one (to_gps) starts a new VIO segment.
+  /// Steps of the time sync the VIO's own clock shows too, seen so far: a pose mapped after a new one (to_gps) is
+  /// stitched to those before. A step it does not show is the time sync's alone: the poses keep the line before it
+  /// until the fit comes back to that line (ignored_steps() counts them, ignored_step_note() says the last).
   [[nodiscard]] int steps_seen() const { return steps_seen_; }
+  [[nodiscard]] int ignored_steps() const { return ignored_steps_; }
+  [[nodiscard]] const std::string& ignored_step_note() const { return ignored_note_; }
 
  private:
   TimeBridgeOptions options_;
@@ -147,6 +181,10 @@ class CausalTimeBridge {
   std::optional<Error> fit_error_;
   int steps_seen_ = 0;
   std::int64_t last_step_ns_ = 0;
+  std::deque<std::int64_t> recent_stamps_ns_;  // the poses' device times of the last 30 s
+  std::optional<TimeBridge> followed_;         // the line before a step the VIO's clock did not show (its last piece)
+  int ignored_steps_ = 0;
+  std::string ignored_note_;
 };
 
 }  // namespace canyon::fusion

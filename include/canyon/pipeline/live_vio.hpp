@@ -82,6 +82,7 @@ class LiveVio {
   fusion::CausalTimeBridge bridge_;
   std::deque<io::VioRecord> pending_;  // received, waiting for their time-sync pairs
   bool stalled_ = false;
+  int ignored_steps_reported_ = 0;  // the bridge's steps of the time sync alone, said so far
   std::atomic<std::uint64_t> poses_{0}, pairs_{0}, dropped_{0}, unmapped_{0}, out_of_order_{0}, late_{0}, appended_{0};
 };
 
