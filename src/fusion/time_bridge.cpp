@@ -16,6 +16,7 @@ constexpr int kMaxIterations = 20;
 constexpr double kMadToSigma = 1.4826;
 constexpr std::int64_t kNsPerWeek = std::int64_t{core::kSecondsPerWeek} * 1000000000;
 constexpr std::int64_t kStampWindowNs = 30'000'000'000;  // the poses' stamps the causal bridge keeps (ns)
+constexpr double kMinDriftSpanS = 10.0;                  // pairs spanning less do not refuse a fit for its drift (s)
 
 /// The median of a copy: the callers keep their vectors' order.
 double median(std::vector<double> v) {
@@ -271,6 +272,22 @@ Result<TimeBridgeFit> fit_time_bridge(const std::vector<io::TimeSyncPair>& input
       const std::string where = pieces == 1 ? std::string{}
                                             : " (pairs at lines " + std::to_string(pairs[begin].line) + " to " +
                                                   std::to_string(pairs[end - 1].line) + ")";
+      const bool short_span = x[end - 1] - x[begin] < kMinDriftSpanS;
+      if (short_span && std::abs((1.0 / line.b - 1.0) * 1e6) > options.max_drift_ppm) {
+        // A few pairs close together fit the drift to their jitter (2 pairs 1 s apart with 0.5 ms jitter: +-700
+        // ppm): beyond the limit it is not the clock's, so the offset is taken alone.
+        std::vector<double> offsets;
+        for (std::size_t i = begin; i < end; ++i) offsets.push_back(y[i] - x[i]);
+        line.b = 1.0;
+        line.a = median(offsets);
+        double sum2 = 0.0;
+        for (const double d : offsets) sum2 += (d - line.a) * (d - line.a);
+        line.residual_rms_s = std::sqrt(sum2 / static_cast<double>(offsets.size()));
+        line.inlier.assign(end - begin, true);
+        line.inliers = static_cast<int>(end - begin);
+        fit.warnings.emplace_back("time-sync pairs spanning less than " + std::to_string(kMinDriftSpanS) +
+                                  " s fit a drift beyond the limit: the offset is taken alone");
+      }
       if (auto e = check_piece(line, end - begin, where, options)) return *e;
     }
     for (std::size_t i = begin; i < end; ++i) {
@@ -337,6 +354,12 @@ Result<core::GpsTime> CausalTimeBridge::to_gps(std::int64_t t_ns) {
                                                 [](std::int64_t t, const io::TimeSyncPair& p) { return t < p.t_ns; }) -
                                pairs_.begin());
   if (end == 0) {
+    // The start: until the first pair is hold old, a pose within hold of it takes its offset alone (the drift over
+    // those seconds is a few microseconds at most), instead of waiting for pairs that can never be older.
+    if (!pairs_.empty() && dropped_ == 0 && t_ns >= pairs_.front().t_ns - hold_ns) {
+      const io::TimeSyncPair& first = pairs_.front();
+      return first.time + static_cast<double>(t_ns - first.t_ns) * 1e-9;
+    }
     return Error{"no time-sync pair " + std::to_string(options_.causal_hold_s) +
                  " s before the VIO pose yet (device time " + std::to_string(t_ns) + " ns)"};
   }

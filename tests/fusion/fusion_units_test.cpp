@@ -135,6 +135,29 @@ TEST(TimeBridgeTest, AStepOfTheTimeSyncIsFittedInPiecesAndOutlierPairsAreNot) {
   EXPECT_EQ(late->outlier_lines.size(), 7U);  // 52, 152, 153 and the last four
 }
 
+TEST(TimeBridgeTest, AFewPairsCloseTogetherDoNotRefuseAFitForItsDrift) {
+  // Three pairs 1 s apart whose jitter makes a 1500 ppm slope: no clock's drift, the offset is taken alone. Over 20 s
+  // the same slope is the clock's, and refused.
+  const core::GpsTime t{2266, 316800.0};
+  const auto pairs_over = [&](double spacing_s) {
+    std::vector<io::TimeSyncPair> pairs;
+    for (int k = 0; k < 3; ++k) {
+      const double device_s = 100.0 + k * spacing_s * (1.0 + 1.5e-3);
+      pairs.push_back(io::TimeSyncPair{std::llround(device_s * 1e9), t + k * spacing_s, k + 2});
+    }
+    return pairs;
+  };
+  auto close = fit_time_bridge(pairs_over(1.0));
+  ASSERT_TRUE(close.ok()) << close.error().to_string();
+  EXPECT_DOUBLE_EQ(close->bridge.drift_ppm(), 0.0);
+  ASSERT_FALSE(close->warnings.empty());
+  EXPECT_NE(close->warnings[0].find("the offset is taken alone"), std::string::npos) << close->warnings[0];
+  EXPECT_LT(std::abs(close->bridge.to_gps(std::llround(101.0015 * 1e9)) - (t + 1.0)), 2e-3);
+  auto wide = fit_time_bridge(pairs_over(10.0));
+  ASSERT_FALSE(wide.ok());
+  EXPECT_NE(wide.error().message.find("drift"), std::string::npos) << wide.error().message;
+}
+
 TEST(TimeBridgeTest, GpsClockStampsMapDirectly) {
   const TimeBridge b = TimeBridge::gps_clock();
   const core::GpsTime t = b.to_gps(std::int64_t{2266} * 604800 * 1000000000 + 316800'500000000);
@@ -446,8 +469,13 @@ TEST(CausalTimeBridgeTest, MapsWithThePairsOlderThanTheHoldOnlyAndOnlyOnceTheyAr
   const std::int64_t t_early = device_ns(1.2);
   EXPECT_FALSE(bridge.ready(t_early));
   ASSERT_TRUE(bridge.add(pairs[0]).ok());
-  EXPECT_TRUE(bridge.ready(t_early));         // a pair later than t - 1.5 s is in
-  EXPECT_FALSE(bridge.to_gps(t_early).ok());  // but none at least 1.5 s older: not mappable
+  EXPECT_TRUE(bridge.ready(t_early));  // a pair later than t - 1.5 s is in
+  // None at least 1.5 s older: at the start a pose within 1.5 s of the first pair takes its offset alone (50 ppm over
+  // 1.2 s: 60 us); one further before it waits for nothing it could use and is not mapped.
+  EXPECT_FALSE(bridge.to_gps(device_ns(-1.6)).ok());
+  const auto early = bridge.to_gps(t_early);
+  ASSERT_TRUE(early.ok());
+  EXPECT_LT(std::abs(*early - (start + 1.2)), 1e-3);
   for (int k = 1; k < 20; ++k) ASSERT_TRUE(bridge.add(pairs[static_cast<std::size_t>(k)]).ok());
   EXPECT_FALSE(bridge.add(pairs[5]).ok());  // not after the last one: refused
   // Each time uses the fit to the last 5 pairs at least 1.5 s older, nothing else.
