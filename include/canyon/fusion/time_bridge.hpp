@@ -30,7 +30,10 @@
 // and only once a pair later than t_ns - hold has been seen (pairs arrive in device-time order, so none of the pairs
 // it uses can still be on its way). With pairs every second and hold 1.5 s a pose waits for nothing in steady state,
 // the fit is extrapolated by at most hold + 1 s, and files and DDS streams give the same mapping (canyon process with
-// timesync_mode: causal equals the rover fed over DDS).
+// timesync_mode: causal equals the rover fed over DDS). At the start, until the first pair is hold old, a pose within
+// hold of it takes that pair's offset alone (the drift over those seconds is microseconds): the VIO is used from the
+// first pair on, as in whole_file. Pairs spanning less than 10 s whose fitted drift is beyond max_drift_ppm give the
+// offset alone too (their slope is their jitter's, not the clock's).
 
 #include <cstdint>
 #include <deque>
@@ -155,7 +158,7 @@ class CausalTimeBridge {
   /// Every pair the mapping of t_ns uses has been received: a pair later than t_ns - hold has been seen.
   [[nodiscard]] bool ready(std::int64_t t_ns) const;
   /// GPST of device time t_ns (queries in increasing t_ns; older pairs are forgotten), or an error: no pair old
-  /// enough yet, or the fit refused (fit_time_bridge's reasons).
+  /// enough yet (a pose more than hold before the first pair), or the fit refused (fit_time_bridge's reasons).
   Result<core::GpsTime> to_gps(std::int64_t t_ns);
   /// Pairs received so far.
   [[nodiscard]] std::uint64_t pairs_received() const { return received_; }
