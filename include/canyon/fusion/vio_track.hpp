@@ -139,7 +139,9 @@ class VioTrack {
   static VioTrack streaming(const VioTrackOptions& options);
 
   /// Appends the pose of `record` at GPST t, its segment assigned as build() would (a new segment: `note`, if
-  /// given, receives why). False, and nothing appended, when t is not after the last pose's time.
+  /// given, receives why); `clock_piece` counts the time-sync steps its mapping follows (CausalTimeBridge::
+  /// steps_seen()): a change breaks the track there. False, and nothing appended, when t is not after the last pose's
+  /// time.
   bool append(const io::VioRecord& record, const core::GpsTime& t, std::string* note = nullptr, int clock_piece = 0);
   /// Forgets the samples before GPST t except the last one before it (memory of a long live run).
   void forget_before(const core::GpsTime& t);
