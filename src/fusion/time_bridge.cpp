@@ -47,16 +47,16 @@ core::GpsTime TimeBridge::to_gps(std::int64_t t_ns) const {
     const std::int64_t rest_ns = t_ns - week * kNsPerWeek;
     return core::GpsTime{static_cast<int>(week), static_cast<double>(rest_ns) * 1e-9}.normalized();
   }
-  const Piece& piece = pieces_[static_cast<std::size_t>(piece_of(t_ns))];
+  return to_gps_with_piece(t_ns, piece_of(t_ns));
+}
+
+core::GpsTime TimeBridge::on_line(const Piece& p, std::int64_t t_ns) const {
   const double x_s = static_cast<double>(t_ns - reference_ns_) * 1e-9;
-  return reference_time_ + (piece.a_s + piece.b * x_s);
+  return reference_time_ + (p.a_s + p.b * x_s);
 }
 
 double TimeBridge::step_s(int k, int from) const {
-  const Piece& to = piece(k);
-  const Piece& before = piece(from);
-  const double x_s = static_cast<double>(to.from_ns - reference_ns_) * 1e-9;
-  return (to.a_s + to.b * x_s) - (before.a_s + before.b * x_s);
+  return on_line(piece(k), piece(k).from_ns) - on_line(piece(from), piece(k).from_ns);
 }
 
 std::optional<std::int64_t> vio_clock_shows_step(const std::vector<std::int64_t>& stamps_ns, std::int64_t after_ns,
@@ -93,9 +93,7 @@ std::vector<VioClockLine> lines_the_vio_follows(const TimeBridge& bridge, const 
 }
 
 core::GpsTime TimeBridge::to_gps_with_piece(std::int64_t t_ns, int k) const {
-  const Piece& p = piece(std::max(k, 0));
-  const double x_s = static_cast<double>(t_ns - reference_ns_) * 1e-9;
-  return reference_time_ + (p.a_s + p.b * x_s);
+  return on_line(piece(std::max(k, 0)), t_ns);
 }
 
 int TimeBridge::piece_of(std::int64_t t_ns) const {

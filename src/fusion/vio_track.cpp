@@ -14,6 +14,21 @@ namespace {
 
 constexpr double kMinResetTraceM2 = 1e-4;  // covariance collapses are only resets from above this trace (m^2)
 
+double position_trace_m2(const VioTrackSample& s) {
+  return s.P.topLeftCorner<3, 3>().trace();
+}
+
+/// The VIO restarted its covariance (with its frame) between prev and s.
+bool covariance_collapsed(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options) {
+  const double prev_trace = position_trace_m2(prev);
+  return prev_trace > kMinResetTraceM2 && position_trace_m2(s) < options.reset_covariance_ratio * prev_trace;
+}
+
+/// s is further from prev than max_speed_mps allows in dt_s.
+bool moved_too_fast(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options, double dt_s) {
+  return (s.T_OI.p - prev.T_OI.p).norm() > options.max_speed_mps * dt_s;
+}
+
 }  // namespace
 
 std::string VioTrackOptions::validate() const {
@@ -61,8 +76,6 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
   const double dt_s = s.t_s - prev.t_s;
   const double jump_m = (s.T_OI.p - prev.T_OI.p).norm();
   const double turn_deg = core::so3_log(prev.T_OI.q.conjugate() * s.T_OI.q).norm() * core::kRadToDeg;
-  const double trace = s.P.topLeftCorner<3, 3>().trace();
-  const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
   char buffer[160];
   if (s.clock_piece != prev.clock_piece) {
     std::snprintf(buffer, sizeof buffer, "VIO time-sync step (%.2f s after the previous pose on GPST)", dt_s);
@@ -74,14 +87,16 @@ std::string segment_break(const VioTrackSample& prev, const VioTrackSample& s, c
     set(SegmentBreak::Gap);
     return buffer;
   }
-  if (jump_m > options.max_speed_mps * dt_s || turn_deg > options.max_rotation_rate_dps * dt_s) {
+  const bool jumped = moved_too_fast(prev, s, options, dt_s);
+  if (jumped || turn_deg > options.max_rotation_rate_dps * dt_s) {
     std::snprintf(buffer, sizeof buffer, "VIO jump of %.2f m and %.1f deg in %.3f s (odometry frame reset)", jump_m,
                   turn_deg, dt_s);
-    set(jump_m > options.max_speed_mps * dt_s ? SegmentBreak::Jump : SegmentBreak::Turn);
+    set(jumped ? SegmentBreak::Jump : SegmentBreak::Turn);
     return buffer;
   }
-  if (prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace) {
-    std::snprintf(buffer, sizeof buffer, "VIO covariance reset (position trace %.3g -> %.3g m^2)", prev_trace, trace);
+  if (covariance_collapsed(prev, s, options)) {
+    std::snprintf(buffer, sizeof buffer, "VIO covariance reset (position trace %.3g -> %.3g m^2)",
+                  position_trace_m2(prev), position_trace_m2(s));
     set(SegmentBreak::CovarianceReset);
     return buffer;
   }
@@ -93,11 +108,8 @@ namespace {
 /// A gap the stream comes back from in the same frame (see the top of vio_track.hpp): short enough, no faster than
 /// max_speed_mps, no covariance collapse.
 bool bridgeable_gap(const VioTrackSample& prev, const VioTrackSample& s, const VioTrackOptions& options, double dt_s) {
-  if (!(dt_s <= options.max_bridged_gap_s)) return false;
-  if ((s.T_OI.p - prev.T_OI.p).norm() > options.max_speed_mps * dt_s) return false;
-  const double trace = s.P.topLeftCorner<3, 3>().trace();
-  const double prev_trace = prev.P.topLeftCorner<3, 3>().trace();
-  return !(prev_trace > kMinResetTraceM2 && trace < options.reset_covariance_ratio * prev_trace);
+  return dt_s <= options.max_bridged_gap_s && !moved_too_fast(prev, s, options, dt_s) &&
+         !covariance_collapsed(prev, s, options);
 }
 
 /// Stitches `s`, the first pose after a jump or reset, to `prev` (and `before_prev`, if of its segment, for the

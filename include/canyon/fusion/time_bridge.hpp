@@ -99,6 +99,8 @@ class TimeBridge {
 
  private:
   TimeBridge() = default;
+  /// t_ns on piece p's line.
+  [[nodiscard]] core::GpsTime on_line(const Piece& p, std::int64_t t_ns) const;
   std::int64_t reference_ns_ = 0;
   core::GpsTime reference_time_;
   std::vector<Piece> pieces_;
