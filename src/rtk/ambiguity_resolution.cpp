@@ -48,9 +48,14 @@ void AmbiguityResolver::commit(const FixCandidate& fix, FilterState& state) {
       last_fix_[dd_key(state, fix.dd[k])] = fix.a_fix[static_cast<Eigen::Index>(k)];
     }
   }
+  hold(fix, state, options_.hold_sigma_cyc);
+}
+
+void AmbiguityResolver::hold(const FixCandidate& fix, FilterState& state, double sigma_cyc) const {
   if (options_.ar_mode == ArMode::FixAndHold) {
-    // Hold: the fixed DD ambiguities as pseudo-measurements with a small variance, into the float filter.
-    const double var = options_.hold_sigma_cyc * options_.hold_sigma_cyc;
+    // Hold: the fixed DD ambiguities (or combinations) as pseudo-measurements with a small variance, into the float
+    // filter.
+    const double var = sigma_cyc * sigma_cyc;
     const auto nd = fix.a_fix.size();
     const Eigen::MatrixXd S = fix.Q_a + var * Eigen::MatrixXd::Identity(nd, nd);
     const Eigen::LLT<Eigen::MatrixXd> hold(S);

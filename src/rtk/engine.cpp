@@ -238,6 +238,7 @@ void RtkEngine::conclude_fixes() {
       sol.P_E_m2 = imprecise->P_E_m2;
       out.note +=
           "; float position conditioned on " + std::to_string(imprecise->a_fix.size()) + " fixed integer combinations";
+      hold_imprecise(*imprecise);
     }
   } else if (!search.fix()->position_ok) {
     out.note = "float ambiguity covariance not positive definite";
@@ -252,6 +253,13 @@ void RtkEngine::conclude_fixes() {
     resolver_.commit(fix, state_);
   }
   pending_->search.reset();
+}
+
+void RtkEngine::hold_imprecise(const FixCandidate& imprecise) {
+  if (options_.partial_hold_sigma_cyc <= 0.0 || !imprecise.position_ok) return;
+  if (pending_->out.solution.num_satellites < options_.partial_hold_min_satellites) return;
+  resolver_.hold(imprecise, state_, options_.partial_hold_sigma_cyc);
+  pending_->out.note += " (held)";
 }
 
 RtkEpoch RtkEngine::take_epoch() {

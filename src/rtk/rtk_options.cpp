@@ -42,6 +42,10 @@ std::string RtkOptions::validate() const {
   }
   if (!(min_partial_fraction >= 0.0 && min_partial_fraction <= 1.0)) return "min_partial_fraction must be in [0, 1]";
   if (!(max_partial_fix_sigma_m > 0.0)) return "max_partial_fix_sigma_m must be > 0";
+  if (!(partial_hold_sigma_cyc >= 0.0 && std::isfinite(partial_hold_sigma_cyc))) {
+    return "partial_hold_sigma_cyc must be finite and >= 0 (0: not held)";
+  }
+  if (partial_hold_min_satellites < 4) return "partial_hold_min_satellites must be >= 4";
   if (!(snr_reference_dbhz > 0.0)) return "snr_reference_dbhz must be > 0";
   if (!(iono_auto_baseline_km >= 0.0)) return "iono_auto_baseline_km must be >= 0";
   if (!(iono_residual_sigma_per_10km_m >= 0.0 && std::isfinite(iono_residual_sigma_per_10km_m))) {

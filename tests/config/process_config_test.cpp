@@ -275,6 +275,16 @@ TEST(ProcessConfigTest, RejectsInvalidValues) {
   auto none = parse("spp:\n  systems: []\n");
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.error().message.find("at least one system"), std::string::npos);
+  for (const char* bad : {"mode: fusion\nrtk:\n  partial_hold_sigma_cyc: -0.1\n",
+                          "mode: fusion\nrtk:\n  partial_hold_min_satellites: 3\n"}) {
+    auto hold = parse(bad);
+    ASSERT_FALSE(hold.ok()) << bad;
+    EXPECT_NE(hold.error().message.find("partial_hold_"), std::string::npos) << hold.error().message;
+  }
+  auto hold = parse("mode: fusion\nrtk:\n  partial_hold_sigma_cyc: 0.2\n");
+  ASSERT_TRUE(hold.ok()) << hold.error().to_string();
+  EXPECT_EQ(hold->rtk.partial_hold_sigma_cyc, 0.2);
+  EXPECT_EQ(hold->rtk.partial_hold_min_satellites, 10);
 }
 
 TEST(ProcessConfigTest, IonosphereIsAutoByDefaultAndEachModeParses) {

@@ -1,7 +1,8 @@
 // Ambiguity resolution (rtk/ambiguity_resolution.hpp) on synthetic floats (synthetic_epoch.hpp): the full set is
 // proposed first with the true integers and its fixed position; a satellite biased by half a cycle is pruned; a
 // caller's refusals send the search on through partial fixing and end without a fix; fewer than 4 satellites are not
-// searched; a fix that contradicts the last one is not proposed; fix-and-hold conditions the state on the integers.
+// searched; a fix that contradicts the last one is not proposed; fix-and-hold conditions the state on the integers;
+// an imprecise partial fix is held with its own sigma without becoming the last fix.
 
 #include "canyon/rtk/ambiguity_resolution.hpp"
 
@@ -135,6 +136,38 @@ TEST(AmbiguityResolution, AFixThatContradictsTheLastOneIsNotProposedAndHoldCondi
   }
   resolver.forget({shifted.sds[2].sat, 0});
   EXPECT_EQ(resolver.last_fix().size(), 6U);
+}
+
+TEST(AmbiguityResolution, HoldConditionsTheStateWithItsSigmaAndLeavesTheLastFixAlone) {
+  testing::SyntheticEpoch e = floats(8);
+  RtkOptions options;
+  options.ar_mode = ArMode::FixAndHold;
+  AmbiguityResolver resolver{options};
+  FixSearch search = resolver.search(e.state, e.sds);
+  run(search, [](const FixCandidate&) { return true; });
+  ASSERT_TRUE(search.fix().has_value());
+  const int s = e.state.index({e.sds[2].sat, 0});
+  const int r = e.state.index({e.sds[0].sat, 0});
+  const auto dd_variance = [&] {
+    const Eigen::MatrixXd& P = e.state.P();
+    return P(s, s) + P(r, r) - 2.0 * P(s, r);
+  };
+  const double before = dd_variance();
+  resolver.hold(*search.fix(), e.state, 0.2);
+  EXPECT_TRUE(resolver.last_fix().empty()) << "a hold is not a fix";
+  // Conditioned with sigma 0.2 cycles: the DD variance falls to about var 0.04 / (var + 0.04) of what it was.
+  EXPECT_LT(dd_variance(), before);
+  EXPECT_GT(dd_variance(), 0.5 * before * 0.04 / (before + 0.04));
+  EXPECT_NEAR(e.state.x()[s] - e.state.x()[r], e.integers[2] - e.integers[0], 0.05);
+  // Outside fix-and-hold a hold does nothing.
+  testing::SyntheticEpoch again = floats(8);
+  AmbiguityResolver continuous{RtkOptions{}};
+  FixSearch search2 = continuous.search(again.state, again.sds);
+  run(search2, [](const FixCandidate&) { return true; });
+  ASSERT_TRUE(search2.fix().has_value());
+  const Eigen::MatrixXd P = again.state.P();
+  continuous.hold(*search2.fix(), again.state, 0.2);
+  EXPECT_EQ(again.state.P(), P);
 }
 
 }  // namespace

@@ -34,7 +34,10 @@
 //      the best accepted of those.
 // A subset keeps at least min_partial_fraction of the ambiguities. GLONASS ambiguities are fixed only with glonass_ar.
 // The fixed position is the conditional update x_b - Q_ba Q_a^-1 (a_float - a_fix) (position rows only). In
-// fix-and-hold the accepted integers are fed back into the filter as pseudo-measurements of sigma hold_sigma_cyc.
+// fix-and-hold the accepted integers are fed back into the filter as pseudo-measurements of sigma hold_sigma_cyc, and
+// with partial_hold_sigma_cyc > 0 the imprecise combinations of step 4 too, of that sigma, at epochs of at least
+// partial_hold_min_satellites satellites (cascaded fixing: the most precise combinations, wide-lane-like, held while
+// the rest converge; in an open square this is what turns a float of 5.5 cm into a fix).
 
 #include <cstdint>
 #include <map>
@@ -92,6 +95,9 @@ class AmbiguityResolver {
   [[nodiscard]] FixSearch search(const FilterState& state, const std::vector<SingleDiff>& sds);
   /// Takes the accepted `fix`: its DD integers become the last fix, and in fix-and-hold they condition `state`.
   void commit(const FixCandidate& fix, FilterState& state);
+  /// In fix-and-hold, conditions `state` on `fix`'s integers with `sigma_cyc` (as commit() does with hold_sigma_cyc)
+  /// without making them the last fix: an imprecise partial fix (partial_hold_sigma_cyc).
+  void hold(const FixCandidate& fix, FilterState& state, double sigma_cyc) const;
 
   /// A DD ambiguity by the keys of its two SD ambiguities (satellite s, reference satellite).
   using DdKey = std::pair<StateKey, StateKey>;

@@ -157,6 +157,8 @@ class RtkEngine {
   /// Whether the ionosphere is estimated at this epoch (Off, Estimate, or Auto by the baseline); turning it off
   /// removes the ionosphere states.
   void choose_ionosphere_model(double baseline_m);
+  /// An imprecise partial fix held in the filter (partial_hold_sigma_cyc), where the epoch qualifies.
+  void hold_imprecise(const FixCandidate& imprecise);
   /// Removes a keyed state from the filter, its bookkeeping and the last fix.
   void remove_state(const StateKey& key);
 

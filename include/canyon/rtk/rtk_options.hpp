@@ -67,7 +67,13 @@ struct RtkOptions {
   /// A new ionosphere state from the others' (ionosphere_prior.hpp): its own vertical residual sigma per 10 km of
   /// baseline (m); 0: every state independent, with the sigma above.
   double iono_residual_sigma_per_10km_m = 0.0;
-  gnss::SppOptions spp;  ///< single-point solution (prior and fallback)
+  /// Fix-and-hold of a partial fix by the success rate that leaves the position less precise than
+  /// max_partial_fix_sigma_m (cascaded fixing: the most precise, wide-lane-like combinations held while the rest
+  /// converge): its integers are held with this sigma (cycles) at epochs of at least partial_hold_min_satellites
+  /// satellites; 0: not held (they condition only the epoch's output).
+  double partial_hold_sigma_cyc = 0.0;
+  int partial_hold_min_satellites = 10;  ///< fewest satellites of an epoch whose imprecise partial fix is held
+  gnss::SppOptions spp;                  ///< single-point solution (prior and fallback)
   /// A heading-error state of the external aiding (see above); set by the aiding's owner (the fusion), not in YAML.
   bool aiding_heading_state = false;
   /// A scale-error state of the external aiding (time_update.hpp); set by the aiding's owner, not in YAML.
