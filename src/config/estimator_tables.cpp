@@ -259,6 +259,9 @@ Table<F> update_keys() {
        at(&F::output_floor, &fusion::OutputFloorOptions::horizontal_sigma_m)},
       {"output_sigma_floor_v_m", "m", "... and this vertical sigma",
        at(&F::output_floor, &fusion::OutputFloorOptions::vertical_sigma_m)},
+      {"output_unfixed_sigma_factor", "",
+       "a solution not fixed is output with its filter sigmas times this (code multipath the filter takes as white)",
+       at(&F::output_floor, &fusion::OutputFloorOptions::unfixed_sigma_factor)},
   };
 }
 

@@ -1,7 +1,7 @@
 // The fusion's pieces one by one, each against its model: the prior of Eqs. 3-6 (predict_with_vio), the innovation
 // gates (line 6), float validation (line 8), the fill-in (line 22), the false-fix guard, the prior recovery, the
 // integrity check, the heading state, the heading-free fill-in, the constant-velocity ablation and the output
-// covariance's floor.
+// covariance (the floor, and the scaling of a solution not fixed).
 
 #include <cmath>
 
@@ -325,6 +325,32 @@ TEST(FusionPieces, TheOutputFloorAddsItsSigmasInTheLocalFrame) {
   add_output_floor(s, OutputFloorOptions{0.0, 0.0});
   EXPECT_EQ(s.P_E_m2, before);
   EXPECT_FALSE((OutputFloorOptions{-0.01, 0.02}.validate().empty()));
+}
+
+TEST(FusionPieces, ASolutionNotFixedIsOutputWithItsSigmasScaledThenFloored) {
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(core::ecef_to_geodetic(kP0));
+  const Eigen::Matrix3d P_E = R_NE.transpose() * Eigen::Vector3d(0.01, 0.04, 0.09).asDiagonal() * R_NE;  // 0.1-0.3 m
+  for (const core::SolutionStatus status : {core::SolutionStatus::Float, core::SolutionStatus::VioFillIn,
+                                            core::SolutionStatus::Single, core::SolutionStatus::Fixed}) {
+    core::Solution s;
+    s.status = status;
+    s.p_E_m = kP0;
+    s.P_E_m2 = P_E;
+    add_output_floor(s, OutputFloorOptions{0.01, 0.02, 3.0});
+    const Eigen::Matrix3d P_N = R_NE * s.P_E_m2 * R_NE.transpose();
+    const double k2 = status == core::SolutionStatus::Fixed ? 1.0 : 9.0;  // a fix keeps the filter's covariance
+    EXPECT_NEAR(P_N(0, 0), k2 * 0.01 + 1e-4, 1e-12) << static_cast<int>(status);
+    EXPECT_NEAR(P_N(2, 2), k2 * 0.09 + 4e-4, 1e-12) << static_cast<int>(status);
+    EXPECT_EQ(s.p_E_m, kP0);  // the position is not touched
+  }
+  // A factor of 1 and no floor leave the covariance as it is; a factor below 1 would hide errors: refused.
+  core::Solution s;
+  s.status = core::SolutionStatus::Float;
+  s.p_E_m = kP0;
+  s.P_E_m2 = P_E;
+  add_output_floor(s, OutputFloorOptions{0.0, 0.0, 1.0});
+  EXPECT_EQ(s.P_E_m2, P_E);
+  EXPECT_FALSE((OutputFloorOptions{0.01, 0.02, 0.5}.validate().empty()));
 }
 
 }  // namespace

@@ -5,7 +5,14 @@
 // the local frame,
 //   P_out = P + R_EN diag(h^2, h^2, v^2) R_NE,
 // h and v the horizontal and vertical sigma of what the filter does not model (the "1 cm + 1 ppm" of a receiver's
-// specification). Only the output: the filter, its fixes and the alignment keep their own covariance.
+// specification). A solution that is not fixed (float, VIO fill-in, single point) has its filter covariance scaled
+// first,
+//   P_out = k^2 P + R_EN diag(h^2, h^2, v^2) R_NE,
+// k = unfixed_sigma_factor: the filter takes code errors as white, and in a street canyon code multipath stays for
+// tens of seconds, so a float (and the fill-in that carries it on) averages biased code and claims a precision it
+// lacks (downtown development seeds 1-10: their median horizontal error is 2.45 of their sigmas, a float's error beyond
+// 3 sigma at 40 % of its epochs). A fix's integers pin the position on carrier phase, which that bias does not reach.
+// Only the output: the filter, its fixes and the alignment keep their own covariance.
 
 #include <string>
 
@@ -14,8 +21,9 @@
 namespace canyon::fusion {
 
 struct OutputFloorOptions {
-  double horizontal_sigma_m = 0.01;  ///< h (m); 0 with v = 0: no floor
-  double vertical_sigma_m = 0.02;    ///< v (m)
+  double horizontal_sigma_m = 0.01;   ///< h (m); 0 with v = 0: no floor
+  double vertical_sigma_m = 0.02;     ///< v (m)
+  double unfixed_sigma_factor = 3.0;  ///< k (>= 1; 1: a solution not fixed keeps its filter covariance)
 
   [[nodiscard]] std::string validate() const;
 };
