@@ -71,6 +71,7 @@ variant no-integrity "integrity_check=false"
 variant no-heading-free "heading_free_fill_in=false"
 variant no-consistency "" "float_consistency_level=0"
 variant cn0-own-bins "cn0_monotone=false"
+variant partial-hold "" "partial_hold_sigma_cyc=0.2"
 
 now() { date +%s.%N; }
 elapsed() { awk -v s="$1" -v e="$2" 'BEGIN {printf "%.2f", e - s}'; }
@@ -170,7 +171,7 @@ if [[ ${ABLATIONS:-1} != 0 ]]; then
   echo
   echo "== 2. Ablations of canyon fusion (fix rate, availability, wrong fixes, 3D RMSE; same files as above)"
   names=(full no-covariance no-pruning no-calibration constant-velocity gate-paper gate-chi-square no-guard no-cn0-screen
-    no-heading no-integrity no-heading-free no-consistency cn0-own-bins)
+    no-heading no-integrity no-heading-free no-consistency cn0-own-bins partial-hold)
   printf '%-14s %4s' scenario seed
   for name in "${names[@]}"; do printf ' | %-30s' "$name"; done
   echo
