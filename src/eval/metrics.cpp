@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "canyon/core/geodesy.hpp"
 #include "canyon/io/pos_file.hpp"
@@ -120,7 +121,8 @@ void append_error_columns(std::string& out, const ErrorStats& e) {
                 e.max_3d_m, e.p95_3d_m);
 }
 
-/// Counts the solution in SolutionStats::epochs_with_covariance and, when e^T C^-1 e > 9, beyond_3_sigma_horizontal.
+/// Counts the solution in SolutionStats::epochs_with_covariance and, when e^T C^-1 e > 9, beyond_3_sigma_horizontal;
+/// when |e| exceeds its protection level, beyond_protection_level.
 void count_beyond_3_sigma(const core::Solution& s, const core::Geodetic& truth, const Eigen::Vector3d& d_N_m,
                           SolutionStats& stats) {
   const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(truth);
@@ -130,6 +132,10 @@ void count_beyond_3_sigma(const core::Solution& s, const core::Geodetic& truth, 
   ++stats.epochs_with_covariance;
   const Eigen::Vector2d e = d_N_m.head<2>();
   if (e.dot(llt.solve(e)) > 9.0) ++stats.beyond_3_sigma_horizontal;
+  const double major_m2 =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(0.5 * (C + C.transpose()), Eigen::EigenvaluesOnly)
+          .eigenvalues()[1];
+  if (e.norm() > kProtectionLevelSigmas * std::sqrt(major_m2)) ++stats.beyond_protection_level;
 }
 
 }  // namespace

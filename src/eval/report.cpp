@@ -194,6 +194,9 @@ std::vector<TableRow> table_rows(const EvaluationReport& report) {
   rows.push_back(row("horizontal error > 3 sigma (%)", report, [](const SolutionReport& s) {
     return count_and_percent(s.stats.beyond_3_sigma_horizontal, s.stats.epochs_with_covariance);
   }));
+  rows.push_back(row("horizontal error > HPL (%)", report, [](const SolutionReport& s) {
+    return count_and_percent(s.stats.beyond_protection_level, s.stats.epochs_with_covariance);
+  }));
   rows.push_back(row("epochs without truth", report,
                      [](const SolutionReport& s) { return std::to_string(s.stats.epochs_without_truth); }));
   rows.push_back(row("time to first fix (s)", report, [](const SolutionReport& s) -> std::string {
@@ -288,6 +291,7 @@ std::string json_solution(const SolutionReport& r, int epochs) {
   out += "      \"correct_fix_rate\": " + rate(correct_fixes(st)) + ",\n";
   out += "      \"beyond_3_sigma_horizontal\": " + std::to_string(st.beyond_3_sigma_horizontal) + ",\n";
   out += "      \"epochs_with_covariance\": " + std::to_string(st.epochs_with_covariance) + ",\n";
+  out += "      \"beyond_protection_level\": " + std::to_string(st.beyond_protection_level) + ",\n";
   out += "      \"epochs_with_truth\": " + std::to_string(st.epochs_with_truth) + ",\n";
   out += "      \"epochs_without_truth\": " + std::to_string(st.epochs_without_truth) + ",\n";
   out += "      \"time_to_first_fix_s\": " + json_optional(st.time_to_first_fix_s) + ",\n";

@@ -154,6 +154,14 @@ TEST(Evaluate, HorizontalErrorsBeyondThreeSigmaOfTheirOwnCovariance) {
   ASSERT_TRUE(stats.ok());
   EXPECT_EQ(stats->epochs_with_covariance, 3);
   EXPECT_EQ(stats->beyond_3_sigma_horizontal, 1);
+  // The protection level, 6 sigma of the major axis (0.1 m east): 0.6 m. 5 sigma north is within it.
+  EXPECT_EQ(stats->beyond_protection_level, 0);
+  set.push_back(with_sigma(at_enu(4, SolutionStatus::Fixed, {0.0, 0.61, 0.0})));   // 0.61 m > 0.6 m
+  set.push_back(with_sigma(at_enu(5, SolutionStatus::Fixed, {0.42, 0.42, 0.0})));  // 0.594 m: within
+  const auto more = evaluate(set, Truth::constant(core::geodetic_to_ecef(kOrigin)));
+  ASSERT_TRUE(more.ok());
+  EXPECT_EQ(more->beyond_protection_level, 1);
+  EXPECT_EQ(more->beyond_3_sigma_horizontal, 3);
 }
 
 TEST(Evaluate, TimeToFirstFix) {

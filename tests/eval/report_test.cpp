@@ -224,6 +224,7 @@ TEST(Report, TextTableSideBySide) {
                        "wrong fixes > 0.10 m (% of fixed)    1 (20.00) :  0 (0.00)\n"
                        "correct fixes <= 0.10 m (%)          4 (40.00) : 6 (60.00)\n"
                        "horizontal error > 3 sigma (%)        0 (0.00) :  0 (0.00)\n"
+                       "horizontal error > HPL (%)            0 (0.00) :  0 (0.00)\n"
                        "epochs without truth                         2 :         0\n"
                        "time to first fix (s)                      2.0 :       2.0\n"
                        "APE 3D, all epochs (m)\n"

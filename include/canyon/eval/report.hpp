@@ -21,7 +21,7 @@
 //     "solutions": [ { "label": L, "file": PATH, "epochs": N, "solved": N, "availability": F,
 //                      "status": { "fixed" | "float" | "single" | "fill_in" | "other": { "epochs": N, "rate": F } },
 //                      "wrong_fixes": N, "wrong_fix_rate": F | null, "correct_fixes": N, "correct_fix_rate": F,
-//                      "beyond_3_sigma_horizontal": N, "epochs_with_covariance": N,
+//                      "beyond_3_sigma_horizontal": N, "epochs_with_covariance": N, "beyond_protection_level": N,
 //                      "epochs_with_truth": N, "epochs_without_truth": N, "time_to_first_fix_s": F | null,
 //                      "ape": { "all" | "fixed" | "float" | "single" | "fill_in" | "other":
 //                               { "epochs": N, "3d": D | null, "horizontal": D | null, "vertical_rmse_m": F | null } }
