@@ -10,8 +10,8 @@
 //   P_out = k^2 P + R_EN diag(h^2, h^2, v^2) R_NE,
 // k = unfixed_sigma_factor: the filter takes code errors as white, and in a street canyon code multipath stays for
 // tens of seconds, so a float (and the fill-in that carries it on) averages biased code and claims a precision it
-// lacks (downtown development seeds 1-10: their median horizontal error is 2.45 of their sigmas, a float's error beyond
-// 3 sigma at 40 % of its epochs). A fix's integers pin the position on carrier phase, which that bias does not reach.
+// lacks (downtown development seeds 1-10: a float's median error is 2.45 of its sigma along the worse horizontal axis,
+// a fill-in's 1.97, a fix's 0.40). A fix's integers pin the position on carrier phase, which that bias does not reach.
 // Only the output: the filter, its fixes and the alignment keep their own covariance.
 
 #include <string>
