@@ -17,11 +17,27 @@
 namespace canyon::fusion {
 namespace {
 
-/// The RTK filter's options with the heading error state when the fusion estimates it.
+/// The RTK filter's options with the aiding's error states (heading, scale, interpolation) the fusion estimates.
 rtk::RtkOptions with_heading_state(rtk::RtkOptions rtk_options, const FusionOptions& options) {
-  rtk_options.aiding_heading_state = options.heading.enabled && options.prediction.kind == Prediction::Vio;
-  rtk_options.aiding_scale_state = options.prediction.scale_state && options.prediction.kind == Prediction::Vio;
+  const bool vio = options.prediction.kind == Prediction::Vio;
+  rtk_options.aiding_heading_state = options.heading.enabled && vio;
+  rtk_options.aiding_scale_state = options.prediction.scale_state && vio;
+  rtk_options.aiding_interpolation_state = options.prediction.interpolation_state && vio;
   return rtk_options;
+}
+
+/// The interpolation error's step between the VIO poses at the state's epoch (`before`) and at the next (`next`):
+/// fully correlated inside one VIO interval (e' = sigma' / sigma e), independent across intervals.
+void couple_interpolation(rtk::ExternalMotion& motion, const VioPoseAt& before, const VioPoseAt& next,
+                          double sigma_before_m, double sigma_next_m) {
+  motion.interpolation_variance_m2 = sigma_before_m * sigma_before_m;
+  if (before.lower == next.lower && sigma_before_m > 0.0) {
+    motion.interpolation_carry = sigma_next_m / sigma_before_m;
+    motion.interpolation_noise_m2 = 0.0;
+  } else {
+    motion.interpolation_carry = 0.0;
+    motion.interpolation_noise_m2 = sigma_next_m * sigma_next_m;
+  }
 }
 
 /// The local vertical (unit, ECEF) at a position.
@@ -107,6 +123,11 @@ Result<bool> FusionEngine::predict(const core::ObsEpoch& rover, const core::ObsE
   epoch_spp_p_E_m_.reset();
   if (geometry->rtk.spp) epoch_spp_p_E_m_ = geometry->rtk.spp->p_E_m;
   auto more = engine_.predict(rover, base, aiding_ ? &aiding_->motion : nullptr, &geometry->rtk);
+  if (more && *more && aiding_ && options_.prediction.interpolation_state) {
+    // With the interpolation state the prior is the filter's own after the time update (the state's correlations
+    // between the position and the interpolation error decide it).
+    aiding_->prior = Prior{engine_.position_E_m(), engine_.position_covariance_E_m2()};
+  }
   if (!more) {
     if (!aiding_) heading_free_epoch_ = heading_free_solution(rover.time, pose);
     if (heading_free_epoch_) return false;  // finish_epoch() outputs it
@@ -147,12 +168,20 @@ std::optional<MotionPrediction> FusionEngine::predict_from_vio(const std::option
   const Eigen::Vector3d p_state = engine_.position_E_m();
   const Eigen::Vector3d up_E = up_at(p_state);
   VioPredictionInput in;
+  const bool interpolation_state = options_.prediction.interpolation_state;
+  double sigma_before_m = 0.0;
+  double sigma_next_m = 0.0;
   {
     const std::shared_lock lock(track_mutex_);
     const std::optional<VioPoseAt> before = track_.pose_at(*engine_.state_time());
     if (!before || before->segment != pose->segment) return std::nullopt;
     in.T_OI_i = before->T_OI;
-    in.joint = track_.joint_covariance(*before, *pose);
+    in.joint = track_.joint_covariance(*before, *pose, !interpolation_state);
+    if (interpolation_state) {
+      sigma_before_m = track_.interpolation_sigma_m(*before);
+      sigma_next_m = track_.interpolation_sigma_m(*pose);
+      couple_interpolation(motion, *before, *pose, sigma_before_m, sigma_next_m);
+    }
   }
   const bool heading_state = options_.heading.enabled;
   in.p_E_m = p_state;
@@ -165,6 +194,12 @@ std::optional<MotionPrediction> FusionEngine::predict_from_vio(const std::option
   const std::optional<double> widen = recovery_.take_widening();
   if (widen) ++stats_.widened;
   MotionPrediction prediction = predict_with_vio(in, options_.prediction, widen);  // Eqs. 3-6
+  if (interpolation_state) {
+    // The filter's prior replaces this one once the time update ran (predict()); until then, and for an epoch that
+    // never gets there, the interpolation errors at both ends as in the increment's covariance.
+    prediction.prior.P_E_m2 +=
+        Eigen::Matrix3d::Identity() * (sigma_before_m * sigma_before_m + sigma_next_m * sigma_next_m);
+  }
   if (heading_state) couple_heading(motion, prediction.increment.dp_E_m, up_E, *alignment, options_.heading);
   if (options_.prediction.scale_state) couple_scale(motion, prediction.increment.dp_E_m, pose->segment);
   return prediction;

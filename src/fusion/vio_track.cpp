@@ -354,7 +354,7 @@ core::Matrix6d VioTrack::sample_covariance(int k, int l) const {
   return sigma;
 }
 
-Matrix12d VioTrack::joint_covariance(const VioPoseAt& a, const VioPoseAt& b) const {
+Matrix12d VioTrack::joint_covariance(const VioPoseAt& a, const VioPoseAt& b, bool with_interpolation) const {
   // xi(a) = J_a0 xi_i + J_a1 xi_i+1, xi(b) = J_b0 xi_j + J_b1 xi_j+1.
   const std::array<int, 4> index = {a.lower, a.lower + 1, b.lower, b.lower + 1};
   const std::array<const core::Matrix6d*, 4> J = {&a.J_lower, &a.J_upper, &b.J_lower, &b.J_upper};
@@ -369,8 +369,8 @@ Matrix12d VioTrack::joint_covariance(const VioPoseAt& a, const VioPoseAt& b) con
           J[static_cast<std::size_t>(v)]->transpose();
     }
   }
-  const double sigma_a_m = interpolation_sigma_m(a);
-  const double sigma_b_m = interpolation_sigma_m(b);
+  const double sigma_a_m = with_interpolation ? interpolation_sigma_m(a) : 0.0;
+  const double sigma_b_m = with_interpolation ? interpolation_sigma_m(b) : 0.0;
   out.topLeftCorner<3, 3>().diagonal().array() += sigma_a_m * sigma_a_m;
   out.block<3, 3>(6, 6).diagonal().array() += sigma_b_m * sigma_b_m;
   if (a.lower == b.lower) {

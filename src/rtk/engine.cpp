@@ -22,7 +22,8 @@ RtkEngine::RtkEngine(RtkOptions options, const gnss::EphemerisStore& ephemerides
     : options_(std::move(options)),
       eph_(ephemerides),
       p_E_base_m_(std::move(p_E_base_m)),
-      state_(StateLayout{options_.dynamics, options_.aiding_heading_state, options_.aiding_scale_state}),
+      state_(StateLayout{options_.dynamics, options_.aiding_heading_state, options_.aiding_scale_state,
+                         options_.aiding_interpolation_state}),
       resolver_(options_),
       geometry_builder_(geometry_options(), eph_, p_E_base_m_) {}
 

@@ -158,6 +158,35 @@ void FilterState::couple_aiding_state(int index, const Eigen::Vector3d& J, doubl
   P_(index, index) += noise;
 }
 
+void FilterState::restart_interpolation(double variance_m2) {
+  const int e = interpolation_index();
+  assert(e >= 0);
+  x_.segment<3>(e).setZero();
+  P_.middleRows<3>(e).setZero();
+  P_.middleCols<3>(e).setZero();
+  P_.block<3, 3>(e, e) = Eigen::Matrix3d::Identity() * variance_m2;
+}
+
+void FilterState::propagate_interpolation(double carry, double noise_m2) {
+  const int e = interpolation_index();
+  assert(e >= 0);
+  // F = I but for the rows of p (p + (carry - 1) e) and of e (carry e): F P on the rows, then (F P) F^T on the
+  // columns, each reading the e block before it is scaled.
+  const double k = carry - 1.0;
+  x_.head<3>() += k * x_.segment<3>(e);
+  x_.segment<3>(e) *= carry;
+  P_.topRows<3>() += k * P_.middleRows<3>(e);
+  P_.middleRows<3>(e) *= carry;
+  P_.leftCols<3>() += k * P_.middleCols<3>(e);
+  P_.middleCols<3>(e) *= carry;
+  // G G^T noise: the same w enters p and e.
+  const Eigen::Matrix3d Q = Eigen::Matrix3d::Identity() * noise_m2;
+  P_.topLeftCorner<3, 3>() += Q;
+  P_.block<3, 3>(0, e) += Q;
+  P_.block<3, 3>(e, 0) += Q;
+  P_.block<3, 3>(e, e) += Q;
+}
+
 void FilterState::set_position(const Eigen::Vector3d& p_E_m, const Eigen::Matrix3d& P_E_m2) {
   x_.head<3>() = p_E_m;
   P_.topRows<3>().setZero();

@@ -142,6 +142,37 @@ TEST(FilterState, HeadingCouplingIsFPFtWithFTheIdentityPlusJTimesPsi) {
   EXPECT_LT((s.P() - expected).norm(), kTolerance * expected.norm());
 }
 
+TEST(FilterState, InterpolationStepIsFPFtPlusGQGtWithTheErrorCarriedIntoThePosition) {
+  FilterState s = filled_state({true, true, true, true}, 5);
+  const int e = s.interpolation_index();
+  ASSERT_EQ(e, 11);  // after position, kinematics, heading and scale
+  EXPECT_EQ(s.num_unkeyed(), 14);
+  s.restart_interpolation(4e-4);
+  EXPECT_TRUE(s.x().segment<3>(e).isZero());
+  EXPECT_TRUE(s.P().middleRows<3>(e).leftCols(e).isZero());
+  const Eigen::Matrix3d P_ee = s.P().block<3, 3>(e, e);
+  EXPECT_TRUE(P_ee.isApprox(Eigen::Matrix3d::Identity() * 4e-4));
+  // Give it a value and correlations (as a measurement update would), then one step inside an interval and one
+  // across.
+  s.restore_values(s.x() + Eigen::VectorXd::Constant(s.size(), 0.01), random_spd(s.size(), 6));
+  for (const auto& [carry, noise] : {std::pair{0.6, 0.0}, std::pair{0.0, 9e-4}}) {
+    const Eigen::VectorXd x0 = s.x();
+    const Eigen::MatrixXd P0 = s.P();
+    s.propagate_interpolation(carry, noise);
+    Eigen::MatrixXd F = Eigen::MatrixXd::Identity(s.size(), s.size());
+    F.block<3, 3>(0, e) = Eigen::Matrix3d::Identity() * (carry - 1.0);
+    F.block<3, 3>(e, e) = Eigen::Matrix3d::Identity() * carry;
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(s.size(), 3);
+    G.topRows<3>().setIdentity();
+    G.middleRows<3>(e).setIdentity();
+    const Eigen::MatrixXd expected = F * P0 * F.transpose() + G * G.transpose() * noise;
+    EXPECT_LT((s.x() - F * x0).norm(), kTolerance);
+    EXPECT_LT((s.P() - expected).norm(), kTolerance * expected.norm());
+  }
+  // Across an interval (carry 0) the position keeps only the chain: the old error is taken out, the new one added.
+  EXPECT_TRUE(s.x().segment<3>(e).isZero());
+}
+
 TEST(FilterState, CorrectionAndConditioningMatchTheirDenseForms) {
   FilterState s = filled_state({false, false}, 5);
   const Eigen::Index n = s.size();

@@ -45,6 +45,12 @@ struct PredictionOptions {
   bool scale_state = true;
   double vio_scale_sigma = 0.01;                     ///< (relative, 1 sigma)
   double vio_scale_random_walk_per_sqrt_km = 0.001;  ///< (relative per sqrt(km) walked)
+  /// Beyond the paper: the error of the VIO position interpolated at a GNSS epoch between two VIO samples
+  /// (vio_track.hpp's interpolation_accel_mps2) as a filter state (rtk/time_update.hpp), not in the increment's
+  /// covariance: there it would enter every increment (times vio_sigma_factor^2) and accumulate like a random walk,
+  /// though the interpolated position is never further off than one interval's missed acceleration. Matters with
+  /// VIO slower than the GNSS epochs (1-2 Hz against 5 Hz).
+  bool interpolation_state = false;
 };
 
 struct VioIncrement {

@@ -151,8 +151,12 @@ class VioTrack {
 
   /// The pose at GPST t, nullopt outside every segment (beyond extrapolation_s) or in a gap.
   [[nodiscard]] std::optional<VioPoseAt> pose_at(const core::GpsTime& t) const;
-  /// Joint covariance of [xi(a); xi(b)] (12 x 12); a and b must be of one segment.
-  [[nodiscard]] Matrix12d joint_covariance(const VioPoseAt& a, const VioPoseAt& b) const;
+  /// Joint covariance of [xi(a); xi(b)] (12 x 12); a and b must be of one segment. `with_interpolation` false: without
+  /// the interpolation's error (a filter that carries it as a state, vio_prediction.hpp).
+  [[nodiscard]] Matrix12d joint_covariance(const VioPoseAt& a, const VioPoseAt& b,
+                                           bool with_interpolation = true) const;
+  /// Position sigma per axis of the interpolation error of `p` (interpolation_accel_mps2; 0 at a sample).
+  [[nodiscard]] double interpolation_sigma_m(const VioPoseAt& p) const;
   /// Covariance of xi(a) alone.
   [[nodiscard]] core::Matrix6d covariance(const VioPoseAt& a) const;
 
@@ -167,8 +171,6 @@ class VioTrack {
       : samples_(std::move(samples)), reference_(reference), options_(options) {}
   /// cov(xi_k, xi_l) for samples k <= l of one segment (indices as in VioPoseAt).
   [[nodiscard]] core::Matrix6d sample_covariance(int k, int l) const;
-  /// Position sigma per axis of the interpolation error of `p` (interpolation_accel_mps2).
-  [[nodiscard]] double interpolation_sigma_m(const VioPoseAt& p) const;
   [[nodiscard]] const VioTrackSample& sample(int index) const {
     return samples_[static_cast<std::size_t>(index - forgotten_)];
   }

@@ -6,6 +6,8 @@
 //   kinematics    v_E_u, a_E_u (6, m/s and m/s^2; with dynamics)
 //   heading       psi (1, rad; the error of an external aiding's heading, with a heading state)
 //   scale         s (1, relative; the error of an external aiding's scale, with a scale state)
+//   interpolation e (3, ECEF, m; the error of an external aiding's position interpolated between its samples, with an
+//                 interpolation state: time_update.hpp)
 //   keyed states  one per StateKey, in the order added: an ambiguity N_sd of (satellite, frequency rank) in cycles,
 //                 a satellite's single-differenced ionosphere I_sd in L1-band metres (frequency kIonosphere), or a
 //                 signal's single-differenced code multipath error in metres (StateKey::code_bias).
@@ -40,9 +42,10 @@ struct StateKey {
 
 /// The layout of the unkeyed blocks.
 struct StateLayout {
-  bool kinematics = false;  ///< velocity and acceleration (the constant-acceleration model)
-  bool heading = false;     ///< the external aiding's heading error
-  bool scale = false;       ///< the external aiding's scale error
+  bool kinematics = false;     ///< velocity and acceleration (the constant-acceleration model)
+  bool heading = false;        ///< the external aiding's heading error
+  bool scale = false;          ///< the external aiding's scale error
+  bool interpolation = false;  ///< the external aiding's interpolation error (3 states)
 };
 
 class FilterState {
@@ -63,9 +66,17 @@ class FilterState {
   [[nodiscard]] int scale_index() const {
     return layout_.scale ? 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) : -1;
   }
-  /// Number of unkeyed states (position, kinematics, heading, scale): the index of the first keyed state.
+  /// Index of the interpolation error block (3); -1 without an interpolation state.
+  [[nodiscard]] int interpolation_index() const {
+    return layout_.interpolation
+               ? 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) + (layout_.scale ? 1 : 0)
+               : -1;
+  }
+  /// Number of unkeyed states (position, kinematics, heading, scale, interpolation): the index of the first keyed
+  /// state.
   [[nodiscard]] int num_unkeyed() const {
-    return 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) + (layout_.scale ? 1 : 0);
+    return 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) + (layout_.scale ? 1 : 0) +
+           (layout_.interpolation ? 3 : 0);
   }
 
   // ---- keyed states ----
@@ -131,6 +142,11 @@ class FilterState {
   /// Its share of the position: p += J x_i, P = F P F^T with F = I + J e_i^T, then its variance grows by `noise`.
   /// The heading error psi: J = up x dp (rad); the scale error s: J = dp.
   void couple_aiding_state(int index, const Eigen::Vector3d& J, double noise);
+  /// The interpolation error restarted: value 0, variance `variance_m2` per axis, uncorrelated (needs the block).
+  void restart_interpolation(double variance_m2);
+  /// One step of the interpolation error e (needs the block): e' = carry e + w, var(w) = noise_m2 per axis, and the
+  /// position takes the change, p' = p + e' - e (x' = F x + G w, P' = F P F^T + G G^T noise_m2, G = [I; I] on p, e).
+  void propagate_interpolation(double carry, double noise_m2);
   /// Sets an aiding error state's value (its variance and correlations kept).
   void set_aiding_value(int index, double value) { x_[index] = value; }
   /// Sets the position, uncorrelated with every other state.

@@ -78,6 +78,8 @@ struct RtkOptions {
   bool aiding_heading_state = false;
   /// A scale-error state of the external aiding (time_update.hpp); set by the aiding's owner, not in YAML.
   bool aiding_scale_state = false;
+  /// An interpolation-error state of the external aiding (time_update.hpp); set by the aiding's owner, not in YAML.
+  bool aiding_interpolation_state = false;
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;

@@ -13,7 +13,11 @@
 // p += dp + J psi with J = dp_d_heading_E_m (= up x dp), P' = F P F^T with F = I + J e_psi^T, and psi walks by
 // heading_noise_rad2; it restarts (value 0, variance heading_variance_rad2, uncorrelated) when the aiding asks and
 // after any epoch that was not aided. With a scale state, s (the increment's relative scale error) adds dp s the same
-// way (J = dp) and walks by scale_noise; it restarts likewise (variance scale_variance).
+// way (J = dp) and walks by scale_noise; it restarts likewise (variance scale_variance). With an interpolation state,
+// e (the error of the aiding's position at this epoch, interpolated between its own samples) is carried instead of
+// being added to Q at every epoch, where it would accumulate as a random walk: the aiding's increment runs between the
+// interpolated positions, so p' = p + dp + e' - e with e' = interpolation_carry e + w, var(w) =
+// interpolation_noise_m2 per axis; it restarts (value 0, variance interpolation_variance_m2) likewise.
 // Either way the ambiguities and ionosphere states are random walks: ambiguity_noise_cyc^2 dt, iono_noise_m^2 dt.
 
 #include <Eigen/Core>
@@ -37,6 +41,10 @@ struct ExternalMotion {
   double scale_noise = 0.0;     ///< random walk of the scale error over this increment (relative^2)
   double scale_variance = 0.0;  ///< variance of the scale error when its state (re)starts (relative^2)
   bool restart_scale = false;   ///< the aiding itself changed (a new odometry segment): restart the scale state
+  // With RtkOptions::aiding_interpolation_state only (above):
+  double interpolation_carry = 0.0;        ///< e' = carry e + w (sigma' / sigma inside one interval, 0 across)
+  double interpolation_noise_m2 = 0.0;     ///< var(w) per axis (m^2)
+  double interpolation_variance_m2 = 0.0;  ///< var(e) at the state's epoch when the state (re)starts (m^2 per axis)
 };
 
 /// The own motion model over dt_s; `reinitialise` (no estimate yet) starts the position from `spp`.
@@ -47,6 +55,7 @@ void own_motion_update(FilterState& state, const RtkOptions& options, double dt_
 struct AidingLive {
   bool heading = false;
   bool scale = false;
+  bool interpolation = false;
 };
 
 /// The external motion; `live` is read and set.
