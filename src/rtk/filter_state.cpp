@@ -141,12 +141,12 @@ void FilterState::propagate_keyed(const KeyedProcess& process) {
   }
 }
 
-void FilterState::restart_aiding_state(int index, double variance) {
-  assert(index >= 0 && index < num_unkeyed());
-  x_[index] = 0.0;
-  P_.row(index).setZero();
-  P_.col(index).setZero();
-  P_(index, index) = variance;
+void FilterState::restart_aiding_state(int index, double variance, int size) {
+  assert(index >= 0 && index + size <= num_unkeyed());
+  x_.segment(index, size).setZero();
+  P_.middleRows(index, size).setZero();
+  P_.middleCols(index, size).setZero();
+  P_.block(index, index, size, size).diagonal().setConstant(variance);
 }
 
 void FilterState::couple_aiding_state(int index, const Eigen::Vector3d& J, double noise) {
@@ -156,15 +156,6 @@ void FilterState::couple_aiding_state(int index, const Eigen::Vector3d& J, doubl
   P_.topRows<3>() += J * P_.row(index);
   P_.leftCols<3>() += P_.col(index) * J.transpose();
   P_(index, index) += noise;
-}
-
-void FilterState::restart_interpolation(double variance_m2) {
-  const int e = interpolation_index();
-  assert(e >= 0);
-  x_.segment<3>(e).setZero();
-  P_.middleRows<3>(e).setZero();
-  P_.middleCols<3>(e).setZero();
-  P_.block<3, 3>(e, e) = Eigen::Matrix3d::Identity() * variance_m2;
 }
 
 void FilterState::propagate_interpolation(double carry, double noise_m2) {

@@ -52,9 +52,9 @@ void external_motion_update(FilterState& state, const ExternalMotion& motion, Ai
                       motion.dp_d_heading_E_m, motion.heading_noise_rad2, live.heading);
   aiding_state_update(state, state.scale_index(), motion.restart_scale, motion.scale_variance, motion.delta_p_E_m,
                       motion.scale_noise, live.scale);
-  if (state.interpolation_index() >= 0) {
+  if (const int e = state.interpolation_index(); e >= 0) {
     if (!live.interpolation) {
-      state.restart_interpolation(motion.interpolation_variance_m2);
+      state.restart_aiding_state(e, motion.interpolation_variance_m2, 3);
       live.interpolation = true;
     }
     state.propagate_interpolation(motion.interpolation_carry, motion.interpolation_noise_m2);

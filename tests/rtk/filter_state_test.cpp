@@ -147,7 +147,7 @@ TEST(FilterState, InterpolationStepIsFPFtPlusGQGtWithTheErrorCarriedIntoThePosit
   const int e = s.interpolation_index();
   ASSERT_EQ(e, 11);  // after position, kinematics, heading and scale
   EXPECT_EQ(s.num_unkeyed(), 14);
-  s.restart_interpolation(4e-4);
+  s.restart_aiding_state(e, 4e-4, 3);
   EXPECT_TRUE(s.x().segment<3>(e).isZero());
   EXPECT_TRUE(s.P().middleRows<3>(e).leftCols(e).isZero());
   const Eigen::Matrix3d P_ee = s.P().block<3, 3>(e, e);

@@ -67,11 +67,7 @@ class FilterState {
     return layout_.scale ? 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) : -1;
   }
   /// Index of the interpolation error block (3); -1 without an interpolation state.
-  [[nodiscard]] int interpolation_index() const {
-    return layout_.interpolation
-               ? 3 + (layout_.kinematics ? 6 : 0) + (layout_.heading ? 1 : 0) + (layout_.scale ? 1 : 0)
-               : -1;
-  }
+  [[nodiscard]] int interpolation_index() const { return layout_.interpolation ? num_unkeyed() - 3 : -1; }
   /// Number of unkeyed states (position, kinematics, heading, scale, interpolation): the index of the first keyed
   /// state.
   [[nodiscard]] int num_unkeyed() const {
@@ -137,13 +133,12 @@ class FilterState {
     double q_code = 0.0;
   };
   void propagate_keyed(const KeyedProcess& process);
-  /// An aiding error state (heading_index() or scale_index()) restarted: value 0, the variance, uncorrelated.
-  void restart_aiding_state(int index, double variance);
+  /// An aiding error state (heading_index() or scale_index(), or the `size` states of interpolation_index()) restarted:
+  /// value 0, the variance on each, uncorrelated.
+  void restart_aiding_state(int index, double variance, int size = 1);
   /// Its share of the position: p += J x_i, P = F P F^T with F = I + J e_i^T, then its variance grows by `noise`.
   /// The heading error psi: J = up x dp (rad); the scale error s: J = dp.
   void couple_aiding_state(int index, const Eigen::Vector3d& J, double noise);
-  /// The interpolation error restarted: value 0, variance `variance_m2` per axis, uncorrelated (needs the block).
-  void restart_interpolation(double variance_m2);
   /// One step of the interpolation error e (needs the block): e' = carry e + w, var(w) = noise_m2 per axis, and the
   /// position takes the change, p' = p + e' - e (x' = F x + G w, P' = F P F^T + G G^T noise_m2, G = [I; I] on p, e).
   void propagate_interpolation(double carry, double noise_m2);
