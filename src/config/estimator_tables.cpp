@@ -94,6 +94,9 @@ Table<O> rtk_model_keys() {
        at(&O::max_post_fit_rejections)},
       {"hold_sigma_cyc", "cycles", "fix-and-hold pseudo-measurement sigma", at(&O::hold_sigma_cyc)},
       {"max_outage_s", "s", "an ambiguity not observed for longer is re-initialised", at(&O::max_outage_s)},
+      {"iono_max_outage_s", "s",
+       "a satellite's ionosphere state not observed for longer is re-initialised (at most max_outage_s: that)",
+       at(&O::iono_max_outage_s)},
       {"slip_gf_threshold_m", "m", "jump of the geometry-free phase counted as a cycle slip (grows with the gap)",
        at(&O::slips, &Slips::gf_threshold_m)},
       {"slip_doppler", "", "also test the phase change against the Doppler", at(&O::slips, &Slips::use_doppler)},
@@ -113,6 +116,10 @@ Table<O> rtk_model_keys() {
        "a new ionosphere state from the others' (their mapped vertical delay) plus a residual of this vertical sigma "
        "per 10 km of baseline; 0: independent states with iono_sigma_per_10km_m",
        at(&O::iono_residual_sigma_per_10km_m)},
+      {"ambiguity_prior_max_sigma_cyc", "cycles",
+       "a new or slipped ambiguity starts from the filter's position (its DD phase against a held ambiguity) when that "
+       "start's sigma is at most this; 0: from its code",
+       at(&O::ambiguity_prior_max_sigma_cyc)},
   };
 }
 

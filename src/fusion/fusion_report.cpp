@@ -36,7 +36,9 @@ std::vector<std::string> FusionEngine::report() const {
       format("; %.0f signals screened out by C/N0; %.0f epochs with fixes of a poorly determined position",
              s.cn0_screened, s.undetermined_fix_epochs) +
       format("; %.0f epochs with fewer than 4 satellites to fix (no fix tried)", s.too_few_to_fix) +
-      format("; %.0f epochs whose float fit no integer vector (success rates scaled)", s.float_inconsistent));
+      format("; %.0f epochs whose float fit no integer vector (success rates scaled)", s.float_inconsistent) +
+      format("; %.0f ambiguities started from the position (slips repaired, signals re-acquired)",
+             s.ambiguities_from_position));
   if (options_.heading.enabled) {
     lines.push_back(
         format("fusion: heading state: T_EO turned by %.2f deg in all by the filter's heading estimates, "

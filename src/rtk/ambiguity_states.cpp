@@ -6,10 +6,11 @@
 
 namespace canyon::rtk {
 
-std::vector<StateKey> AmbiguityStates::stale(const core::GpsTime& t, double max_outage_s) const {
+std::vector<StateKey> AmbiguityStates::stale(const core::GpsTime& t, double max_outage_s,
+                                             double iono_max_outage_s) const {
   std::vector<StateKey> keys;
   for (const auto& [key, info] : info_) {
-    if (t - info.last_seen > max_outage_s) keys.push_back(key);
+    if (t - info.last_seen > (key.ionosphere() ? iono_max_outage_s : max_outage_s)) keys.push_back(key);
   }
   return keys;
 }

@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "canyon/rtk/ambiguity_prior.hpp"
 #include "canyon/rtk/ionosphere_prior.hpp"
 
 namespace canyon::rtk {
@@ -131,13 +132,22 @@ void RtkEngine::predict_states(const core::ObsEpoch& rover, EpochGeometry& geome
 
 void RtkEngine::track_states(std::vector<SingleDiff>& sds, const core::GpsTime& t, const SlipScan& slips) {
   for (const SlipEvent& e : slips.events) remove_state({e.sat, e.frequency});
-  for (const StateKey& key : states_.stale(t, options_.max_outage_s)) remove_state(key);
-  state_.add(states_.admit(sds, state_, t, slips, options_, iono_estimated_));
+  const double iono_max_outage_s = std::max(options_.max_outage_s, options_.iono_max_outage_s);
+  for (const StateKey& key : states_.stale(t, options_.max_outage_s, iono_max_outage_s)) remove_state(key);
+  const std::vector<FilterState::NewState> added = states_.admit(sds, state_, t, slips, options_, iono_estimated_);
+  state_.add(added);
   if (iono_estimated_) {
     const double baseline_10km = (state_.position_E_m() - p_E_base_m_).norm() / 1e4;
     const IonospherePrior prior{std::max(options_.iono_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m),
                                 options_.iono_residual_sigma_per_10km_m * baseline_10km, options_.iono_sigma_min_m};
     add_ionosphere_states(state_, sds, prior, eph_);
+  }
+  if (options_.ambiguity_prior_max_sigma_cyc > 0.0 && !added.empty()) {
+    std::vector<StateKey> keys;
+    keys.reserve(added.size());
+    for (const FilterState::NewState& s : added) keys.push_back(s.key);
+    pending_->out.ambiguities_from_position =
+        start_ambiguities_from_position(state_, sds, keys, options_.ambiguity_prior_max_sigma_cyc);
   }
   assign_state_indices(sds, state_);
 }

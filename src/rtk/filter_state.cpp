@@ -43,7 +43,8 @@ void FilterState::add(const std::vector<NewState>& states) {
   P_.swap(P);
 }
 
-void FilterState::add_combination(const StateKey& key, const std::vector<Term>& terms, double residual_variance) {
+void FilterState::add_combination(const StateKey& key, const std::vector<Term>& terms, double residual_variance,
+                                  double offset) {
   const Eigen::Index n = x_.size();
   Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
   for (const Term& t : terms) {
@@ -52,7 +53,7 @@ void FilterState::add_combination(const StateKey& key, const std::vector<Term>& 
   }
   const Eigen::VectorXd Pw = P_ * w;
   x_.conservativeResize(n + 1);
-  x_[n] = w.dot(x_.head(n));
+  x_[n] = offset + w.dot(x_.head(n));
   P_.conservativeResize(n + 1, n + 1);
   P_.topRightCorner(n, 1) = Pw;
   P_.bottomLeftCorner(1, n) = Pw.transpose();

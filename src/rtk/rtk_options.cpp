@@ -60,8 +60,13 @@ std::string RtkOptions::validate() const {
     return "code_multipath_correlation_s must be finite and > 0";
   }
   if (!(max_age_s > 0.0)) return "max_age_s must be > 0";
+  if (!(iono_max_outage_s >= 0.0 && std::isfinite(iono_max_outage_s)))
+    return "iono_max_outage_s must be finite and >= 0";
   if (!(initial_ambiguity_sigma_cyc > 0.0)) return "initial_ambiguity_sigma_cyc must be > 0";
   if (!(hold_sigma_cyc > 0.0)) return "hold_sigma_cyc must be > 0";
+  if (!(ambiguity_prior_max_sigma_cyc >= 0.0 && ambiguity_prior_max_sigma_cyc < 0.5)) {
+    return "ambiguity_prior_max_sigma_cyc must be >= 0 and < 0.5";
+  }
   if (!(max_post_fit_sigmas > 0.0) || !(max_post_fit_code_sigmas > 0.0) || max_post_fit_rejections < 0) {
     return "max_post_fit_sigmas and max_post_fit_code_sigmas must be > 0 and max_post_fit_rejections >= 0";
   }

@@ -63,10 +63,10 @@ TEST(AmbiguityStates, StaleAfterAnOutageAndIonosphereStatesWithTheirPrior) {
   const int iono = state.index({e.sds[0].sat, StateKey::kIonosphere});
   ASSERT_GE(iono, 0);
   EXPECT_DOUBLE_EQ(state.P()(iono, iono), 0.05 * 0.05);
-  EXPECT_TRUE(book.stale(at(14.0), 5.0).empty());
-  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 6U);  // the ionosphere states marked seen as well
+  EXPECT_TRUE(book.stale(at(14.0), 5.0, 5.0).empty());
+  EXPECT_EQ(book.stale(at(16.0), 5.0, 5.0).size(), 6U);  // the ionosphere states marked seen as well
   book.forget(added[0].key);
-  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 5U);
+  EXPECT_EQ(book.stale(at(16.0), 5.0, 5.0).size(), 5U);
 }
 
 TEST(AmbiguityStates, CodeMultipathStatesComeWithEachSignalsCodeAndTheirSigma) {
@@ -88,7 +88,7 @@ TEST(AmbiguityStates, CodeMultipathStatesComeWithEachSignalsCodeAndTheirSigma) {
   assign_state_indices(e.sds, state);
   EXPECT_EQ(e.sds[1].code_bias, state.index(StateKey::code_bias(e.sds[1].sat, 0)));
   EXPECT_EQ(e.sds[2].code_bias, -1);
-  EXPECT_EQ(book.stale(at(16.0), 5.0).size(), 4U);  // stale with the others
+  EXPECT_EQ(book.stale(at(16.0), 5.0, 5.0).size(), 4U);  // stale with the others
 }
 
 }  // namespace

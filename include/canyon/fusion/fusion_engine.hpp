@@ -65,9 +65,11 @@ struct FusionStats {
   int float_rejected_no_phase = 0;
   int float_rejected_post_fit = 0;
   int float_rejected_prior = 0;
-  int guard_epochs = 0;             ///< epochs in which the false-fix guard refused at least one candidate
-  int guard_candidates = 0;         ///< candidate fixes it refused
-  int gated_rows = 0;               ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
+  int guard_epochs = 0;      ///< epochs in which the false-fix guard refused at least one candidate
+  int guard_candidates = 0;  ///< candidate fixes it refused
+  int gated_rows = 0;        ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
+  int ambiguities_from_position =
+      0;                            ///< new or slipped ambiguities started from the position (rtk/ambiguity_prior.hpp)
   int cn0_screened = 0;             ///< signals removed by the C/N0 screen
   int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its position sigma
   int too_few_to_fix = 0;           ///< aided epochs whose fixable ambiguities came from fewer than 4 satellites

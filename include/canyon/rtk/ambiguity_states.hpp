@@ -19,8 +19,10 @@ namespace canyon::rtk {
 
 class AmbiguityStates {
  public:
-  /// Keys of the states not seen for longer than `max_outage_s` before `t`, in key order.
-  [[nodiscard]] std::vector<StateKey> stale(const core::GpsTime& t, double max_outage_s) const;
+  /// Keys of the states not seen for longer than `max_outage_s` (ionosphere states: `iono_max_outage_s`) before `t`,
+  /// in key order.
+  [[nodiscard]] std::vector<StateKey> stale(const core::GpsTime& t, double max_outage_s,
+                                            double iono_max_outage_s) const;
   /// A state left the filter.
   void forget(const StateKey& key) { info_.erase(key); }
   void clear() { info_.clear(); }

@@ -95,10 +95,11 @@ class FilterState {
     int index = 0;
     double weight = 0.0;
   };
-  /// Appends a keyed state that is a linear combination of held states plus an independent residual:
-  /// x_new = sum w_i x_i + r, var(r) = residual_variance; its covariances with every state follow (P_new,* = sum w_i
-  /// P_i,*), so what the held states learn later moves it as well.
-  void add_combination(const StateKey& key, const std::vector<Term>& terms, double residual_variance);
+  /// Appends a keyed state that is a linear combination of held states plus a constant and an independent residual:
+  /// x_new = offset + sum w_i x_i + r, var(r) = residual_variance; its covariances with every state follow (P_new,* =
+  /// sum w_i P_i,*), so what the held states learn later moves it as well.
+  void add_combination(const StateKey& key, const std::vector<Term>& terms, double residual_variance,
+                       double offset = 0.0);
   /// Removes a keyed state (no-op if absent).
   void remove(const StateKey& key);
   /// Removes every keyed state.

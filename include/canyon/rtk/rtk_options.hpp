@@ -57,8 +57,12 @@ struct RtkOptions {
   int max_post_fit_rejections = 3;            ///< at most this many signals (phase or code) rejected per epoch
   double hold_sigma_cyc = 0.001;              ///< fix-and-hold pseudo-measurement sigma (cycles)
   double max_outage_s = 5.0;                  ///< an ambiguity not observed for longer is re-initialised
-  CycleSlipOptions slips;                     ///< cycle-slip detection at each receiver
-  bool troposphere_saastamoinen = true;       ///< model the troposphere at each receiver (off: data without one)
+  /// A satellite's ionosphere state not observed for longer is re-initialised (s; at most max_outage_s counts as it):
+  /// the ionosphere walks slowly (iono_noise_m), so a state kept through a blockage starts the re-acquired signal's
+  /// ambiguity from the position (ambiguity_prior.hpp) where a fresh one's 20 km prior would not allow it.
+  double iono_max_outage_s = 0.0;
+  CycleSlipOptions slips;                ///< cycle-slip detection at each receiver
+  bool troposphere_saastamoinen = true;  ///< model the troposphere at each receiver (off: data without one)
   IonosphereModel ionosphere = IonosphereModel::Auto;  ///< differential ionosphere model
   double iono_auto_baseline_km = 10.0;  ///< with Auto, the ionosphere is estimated on baselines longer than this
   double iono_sigma_per_10km_m = 0.03;  ///< prior sigma of a SD ionosphere state per 10 km of baseline (m)
@@ -67,6 +71,10 @@ struct RtkOptions {
   /// A new ionosphere state from the others' (ionosphere_prior.hpp): its own vertical residual sigma per 10 km of
   /// baseline (m); 0: every state independent, with the sigma above.
   double iono_residual_sigma_per_10km_m = 0.0;
+  /// A new or slipped ambiguity from the filter's position (ambiguity_prior.hpp): started as the DD phase's ambiguity
+  /// against a held one when that start's sigma is at most this (cycles); 0: every new ambiguity from its code, with
+  /// initial_ambiguity_sigma_cyc.
+  double ambiguity_prior_max_sigma_cyc = 0.0;
   /// Fix-and-hold of a partial fix by the success rate that leaves the position less precise than
   /// max_partial_fix_sigma_m (cascaded fixing: the most precise, wide-lane-like combinations held while the rest
   /// converge): its integers are held with this sigma (cycles) at epochs of at least partial_hold_min_satellites
