@@ -311,12 +311,14 @@ class RoverHost:
         rows = []
         try:
             with open(self.path("solutions.csv")) as f:
-                next(f, None)
+                header = next(f, "").strip().split(",")  # the columns by name (canyon record's CSV header)
                 for line in f:
-                    c = line.strip().split(",")
-                    if len(c) == 14:
-                        rows.append({"seq": int(c[0]), "gps_s": int(c[1]) * 604800 + float(c[2]),
-                                     "status": int(c[3]), "age_s": float(c[12]), "received_ns": int(c[13])})
+                    cells = line.strip().split(",")
+                    if len(cells) == len(header):  # not a line cut short
+                        c = dict(zip(header, cells))
+                        rows.append({"seq": int(c["seq"]), "gps_s": int(c["gps_week"]) * 604800 + float(c["gps_tow_s"]),
+                                     "status": int(c["status"]), "age_s": float(c["age_s"]),
+                                     "received_ns": int(c["received_monotonic_ns"])})
         except OSError:
             pass
         return rows

@@ -136,6 +136,10 @@ std::string prometheus_text(const std::string& snapshot_json, std::uint64_t snap
     }
     header(out, "canyon_solution_ratio", "gauge", "Ambiguity ratio test value of the newest solution.");
     sample(out, "canyon_solution_ratio", "", s.value("ratio", Json()));
+    header(out, "canyon_solution_hpl_m", "gauge", "Horizontal protection level of the newest solution (6 sigma).");
+    sample(out, "canyon_solution_hpl_m", "", s.value("hpl_m", Json()));
+    header(out, "canyon_solution_vpl_m", "gauge", "Vertical protection level of the newest solution (6 sigma).");
+    sample(out, "canyon_solution_vpl_m", "", s.value("vpl_m", Json()));
     header(out, "canyon_solution_height_m", "gauge", "Ellipsoidal height of the newest solution.");
     sample(out, "canyon_solution_height_m", "", s.value("height_m", Json()));
   }

@@ -11,6 +11,7 @@
 
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/protection_level.hpp"
 
 namespace canyon::dds {
 namespace {
@@ -84,6 +85,9 @@ msg::Solution to_msg_solution(const pipeline::SolvedEpoch& solved, const EpochCo
     m.status(static_cast<std::uint8_t>(s.status));
     m.p_E_m({s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z()});
     m.covariance_E_m2(upper(s.P_E_m2));
+    const core::ProtectionLevels pl = core::protection_levels(s.p_E_m, s.P_E_m2);
+    m.hpl_m(pl.horizontal_m);
+    m.vpl_m(pl.vertical_m);
     if (s.v_E_mps) m.v_E_mps({s.v_E_mps->x(), s.v_E_mps->y(), s.v_E_mps->z()});
     const core::Geodetic g = core::ecef_to_geodetic(s.p_E_m);
     m.lat_deg(g.lat_rad * core::kRadToDeg);
@@ -99,6 +103,8 @@ msg::Solution to_msg_solution(const pipeline::SolvedEpoch& solved, const EpochCo
     m.note(o.note.substr(0, kMaxNote));
   } else {
     m.status(0);
+    m.hpl_m(std::numeric_limits<double>::quiet_NaN());
+    m.vpl_m(std::numeric_limits<double>::quiet_NaN());
     m.note(solved.output.error().message.substr(0, kMaxNote));
   }
   m.stamps(to_msg_stamps(item));
@@ -334,6 +340,7 @@ Result<core::Solution> from_msg(const msg::Solution& m) {
   s.age_s = m.age_s();
   s.ratio = m.ratio();
   if (status != 0 && (!s.p_E_m.allFinite() || !std::isfinite(m.gps_tow_s()))) return Error{which + ": not finite"};
+  if (m.hpl_m() < 0.0 || m.vpl_m() < 0.0) return Error{which + ": a negative protection level"};
   return s;
 }
 
@@ -347,6 +354,8 @@ pipeline::SolutionSample to_sample(const msg::Solution& m, std::int64_t received
   s.height_m = m.height_m();
   s.n_sats = m.num_satellites();
   s.ratio = m.ratio();
+  s.hpl_m = m.hpl_m();
+  s.vpl_m = m.vpl_m();
   for (const auto& p : m.pruned()) s.pruned.push_back(p.to_string());
   s.arrival_ns = m.stamps().arrival_monotonic_ns();
   s.base_send_ns = m.stamps().base_send_monotonic_ns();
@@ -387,10 +396,11 @@ std::string describe(const msg::Solution& m) {
   char line[512];
   std::string pruned;
   for (const auto& p : m.pruned()) pruned += " " + p.to_string();
-  std::snprintf(line, sizeof line, "solution #%llu %s %d %.3f Q%d %.9f %.9f %.4f ns %d ratio %.1f age %.1f%s%s%s",
+  std::snprintf(line, sizeof line,
+                "solution #%llu %s %d %.3f Q%d %.9f %.9f %.4f ns %d ratio %.1f age %.1f HPL %.3f VPL %.3f%s%s%s",
                 static_cast<unsigned long long>(m.sequence_number()), m.rover_id().c_str(), m.gps_week(), m.gps_tow_s(),
-                m.status(), m.lat_deg(), m.lon_deg(), m.height_m(), m.num_satellites(), m.ratio(), m.age_s(),
-                pruned.empty() ? "" : " pruned", pruned.c_str(),
+                m.status(), m.lat_deg(), m.lon_deg(), m.height_m(), m.num_satellites(), m.ratio(), m.age_s(), m.hpl_m(),
+                m.vpl_m(), pruned.empty() ? "" : " pruned", pruned.c_str(),
                 m.note().size() == 0 ? "" : (" (" + m.note().to_string() + ")").c_str());
   return line;
 }

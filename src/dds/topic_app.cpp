@@ -108,7 +108,7 @@ void TopicApp::open_record_output() {
   raw_.open(out, std::ios::binary | std::ios::trunc);
   if (!raw_) throw AppError(kExitRuntime, Error{"cannot create " + out});
   if (solutions_) {
-    raw_ << "seq,gps_week,gps_tow_s,status,x_m,y_m,z_m,lat_deg,lon_deg,height_m,n_sats,ratio,age_s,"
+    raw_ << "seq,gps_week,gps_tow_s,status,x_m,y_m,z_m,lat_deg,lon_deg,height_m,n_sats,ratio,age_s,hpl_m,vpl_m,"
             "received_monotonic_ns\n";
   } else if (ends_with(options_.topic, "vio")) {
     raw_ << io::vio_csv_header() << '\n';
@@ -163,10 +163,10 @@ void TopicApp::record_solution(const msg::Solution& m, std::int64_t now) {
     // CSV: every sample, those without a solution (status 0) too, so that the sequence numbers account for every
     // epoch; received_monotonic_ns is this recorder's clock (CLOCK_MONOTONIC, shared by a host's namespaces).
     char line[360];
-    std::snprintf(line, sizeof line, "%llu,%d,%.3f,%d,%.4f,%.4f,%.4f,%.9f,%.9f,%.4f,%d,%.2f,%.2f,%lld\n",
+    std::snprintf(line, sizeof line, "%llu,%d,%.3f,%d,%.4f,%.4f,%.4f,%.9f,%.9f,%.4f,%d,%.2f,%.2f,%.3f,%.3f,%lld\n",
                   static_cast<unsigned long long>(m.sequence_number()), m.gps_week(), m.gps_tow_s(), m.status(),
                   m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2], m.lat_deg(), m.lon_deg(), m.height_m(), m.num_satellites(),
-                  m.ratio(), m.age_s(), static_cast<long long>(now));
+                  m.ratio(), m.age_s(), m.hpl_m(), m.vpl_m(), static_cast<long long>(now));
     raw_ << line << std::flush;  // followed live (a line a second): each sample reaches the file at once
     if (m.status() != 0 && !from_msg(m)) ++bad_;
     return;

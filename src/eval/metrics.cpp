@@ -6,9 +6,9 @@
 #include <numeric>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/protection_level.hpp"
 #include "canyon/io/pos_file.hpp"
 
 namespace canyon::eval {
@@ -132,10 +132,7 @@ void count_beyond_3_sigma(const core::Solution& s, const core::Geodetic& truth, 
   ++stats.epochs_with_covariance;
   const Eigen::Vector2d e = d_N_m.head<2>();
   if (e.dot(llt.solve(e)) > 9.0) ++stats.beyond_3_sigma_horizontal;
-  const double major_m2 =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(0.5 * (C + C.transpose()), Eigen::EigenvaluesOnly)
-          .eigenvalues()[1];
-  if (e.norm() > kProtectionLevelSigmas * std::sqrt(major_m2)) ++stats.beyond_protection_level;
+  if (e.norm() > core::horizontal_protection_level_m(C)) ++stats.beyond_protection_level;
 }
 
 }  // namespace

@@ -146,7 +146,8 @@ std::string MonitorModel::json_line(std::int64_t now_ns) const {
          ",\"lat_deg\":" + number(s.lat_deg, "%.9f") + ",\"lon_deg\":" + number(s.lon_deg, "%.9f") +
          ",\"height_m\":" + number(s.height_m, "%.4f") + ",\"n_sats\":" + std::to_string(s.n_sats) + ",\"pruned\":[";
     for (std::size_t i = 0; i < s.pruned.size(); ++i) j += (i > 0 ? "," : "") + quoted(s.pruned[i]);
-    j += "],\"ratio\":" + number(s.ratio, "%.2f") + "}";
+    j += "],\"ratio\":" + number(s.ratio, "%.2f") + ",\"hpl_m\":" + number(s.hpl_m, "%.3f") +
+         ",\"vpl_m\":" + number(s.vpl_m, "%.3f") + "}";
   } else {
     j += ",\"solution\":null";
   }
@@ -205,9 +206,10 @@ std::vector<std::string> MonitorModel::text(std::int64_t now_ns) const {
     const SolutionSample& s = *last_solution_;
     std::string pruned;
     for (const std::string& p : s.pruned) pruned += " " + p;
-    std::snprintf(line, sizeof line, "solution #%llu  Q %d  %.8f %.8f %.3f m  %d sats  ratio %.1f  pruned:%s",
+    std::snprintf(line, sizeof line,
+                  "solution #%llu  Q %d  %.8f %.8f %.3f m  %d sats  ratio %.1f  HPL %.2f VPL %.2f m  pruned:%s",
                   static_cast<unsigned long long>(s.seq), s.status, s.lat_deg, s.lon_deg, s.height_m, s.n_sats, s.ratio,
-                  pruned.empty() ? " -" : pruned.c_str());
+                  s.hpl_m, s.vpl_m, pruned.empty() ? " -" : pruned.c_str());
     lines.emplace_back(line);
   }
   return lines;

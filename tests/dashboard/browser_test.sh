@@ -87,13 +87,18 @@ if ! python3 -c "import sys; sys.exit(0 if float('${last2}') > float('${last1}')
   echo "FAILED: the monitor time did not advance between the two readings"
   fail=1
 fi
+protection="$(reading second protection)"
+if [[ ! "${protection}" =~ ^[0-9.]+\ /\ [0-9.]+\ m$ ]]; then
+  echo "FAILED: the protection level tile shows '${protection}', not 'H / V m'"
+  fail=1
+fi
 if [[ "${charts}" -lt 8 || "${drawn}" != "${charts}" ]]; then
   echo "FAILED: not every chart drew"
   fail=1
 fi
 metrics="$(python3 -c "import urllib.request; print(urllib.request.urlopen('${url}metrics', timeout=5).read().decode())")"
 for want in 'canyon_solution_status ' 'canyon_correction_age_seconds ' 'canyon_stage_latency_us{stage="update",quantile="0.99"}' \
-  'canyon_lever_arm_m{axis="x"}'; do
+  'canyon_lever_arm_m{axis="x"}' 'canyon_solution_hpl_m ' 'canyon_solution_vpl_m '; do
   if ! grep -qF "${want}" <<< "${metrics}"; then
     echo "FAILED: /metrics has no ${want}"
     fail=1

@@ -48,7 +48,8 @@ def main():
             "solution": {"seq": i, "status": status, "lat_deg": 48.137 + 20 * math.sin(angle) / 6371000 * 180 / math.pi,
                          "lon_deg": 11.575 + 20 * math.cos(angle) / (6371000 * math.cos(math.radians(48.137))) * 180 / math.pi,
                          "height_m": 520.0 + 0.05 * math.sin(t), "n_sats": 14 + int(4 * math.sin(t / 7)),
-                         "pruned": ["G05", "E11"][: int(phase // 10)], "ratio": round(3 + 5 * (status == 1), 2)},
+                         "pruned": ["G05", "E11"][: int(phase // 10)], "ratio": round(3 + 5 * (status == 1), 2),
+                         "hpl_m": round(0.06 if status == 1 else 1.8, 3), "vpl_m": round(0.12 if status == 1 else 3.0, 3)},
             "alignment": {"rmse_m": round(0.3 * math.exp(-t / 20) + 0.03, 4), "eigen_ratio": round(2 + 10 * (1 - math.exp(-t / 15)), 3),
                           "lever_arm_m": [round(-0.1 + 0.05 * math.exp(-t / 10), 4), round(0.05 - 0.03 * math.exp(-t / 10), 4), 0.0]},
         }

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "canyon/core/protection_level.hpp"
 #include "canyon/dds/dds.hpp"
 #include "canyon/dds/rover_msgs.hpp"
 #include "canyon/pipeline/monitor_model.hpp"
@@ -87,6 +88,12 @@ TEST(RoverMsgs, SolutionRoundTripsBitForBit) {
   EXPECT_EQ(s->status, core::SolutionStatus::Fixed);
   ASSERT_EQ(m.pruned().size(), 1U);
   EXPECT_EQ(m.pruned()[0].to_string(), "G05");
+  // The protection levels go out with the solution, from its covariance (core/protection_level.hpp).
+  const core::ProtectionLevels pl = core::protection_levels(item.output->solution.p_E_m, item.output->solution.P_E_m2);
+  EXPECT_EQ(m.hpl_m(), pl.horizontal_m);
+  EXPECT_EQ(m.vpl_m(), pl.vertical_m);
+  EXPECT_GT(m.hpl_m(), 6.0 * 0.01);  // at least 6 sigma of the smallest axis (1 cm)
+  EXPECT_NE(describe(m).find("HPL"), std::string::npos);
 
   msg::Solution bad = m;
   bad.status(3);
@@ -94,6 +101,9 @@ TEST(RoverMsgs, SolutionRoundTripsBitForBit) {
   bad = m;
   bad.pruned(std::vector<eprosima::fastrtps::fixed_string<4>>(200, "G01"));
   EXPECT_FALSE(from_msg(bad).ok());
+  bad = m;
+  bad.hpl_m(-1.0);
+  EXPECT_NE(from_msg(bad).error().message.find("protection level"), std::string::npos);
 }
 
 TEST(RoverMsgs, VioPoseAndTimeSyncRoundTripBitForBitAndRefuseMalformed) {

@@ -132,6 +132,8 @@ function ingest(s) {
     document.getElementById('v-status').style.color = statusColor(sol.status);
     document.getElementById('v-sats').textContent = `${sol.n_sats ?? '-'} / ${pruned ?? '-'}`;
     document.getElementById('v-ratio').textContent = num(sol.ratio) !== null ? sol.ratio.toFixed(1) : '-';
+    document.getElementById('v-pl').textContent =
+      num(sol.hpl_m) !== null ? `${sol.hpl_m.toFixed(2)} / ${num(sol.vpl_m) !== null ? sol.vpl_m.toFixed(2) : '-'} m` : '-';
   }
   const al = s.alignment;
   if (al) {
@@ -175,6 +177,7 @@ function render() {
     el.dataset.lastT = String(state.lastT);
     el.dataset.charts = String(Object.keys(charts).length);
     el.dataset.drawn = String(drawnCharts());
+    el.dataset.protection = document.getElementById('v-pl').textContent;
   });
 }
 

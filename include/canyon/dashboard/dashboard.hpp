@@ -6,7 +6,7 @@
 // Snapshot: one JSON object per line (fields optional except t_s; unknown fields are kept and passed on):
 //   {"t_s": s, "stages": {NAME: {"p50_us","p95_us","p99_us","max_us","count"}}, "end_to_end": {same},
 //    "correction_age_s": s, "queues": {NAME: depth}, "drops": {NAME: count},
-//    "solution": {"seq","status","lat_deg","lon_deg","height_m","n_sats","pruned":[...],"ratio"},
+//    "solution": {"seq","status","lat_deg","lon_deg","height_m","n_sats","pruned":[...],"ratio","hpl_m","vpl_m"},
 //    "alignment": {"rmse_m","eigen_ratio","lever_arm_m":[x,y,z]}}
 // status: 1 fixed, 2 float, 5 single, 7 VIO fill-in (DESIGN.md).
 //

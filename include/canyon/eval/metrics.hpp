@@ -64,10 +64,6 @@ inline constexpr std::size_t kNumStatusClasses = 5;
 [[nodiscard]] StatusClass status_class(core::SolutionStatus status);
 [[nodiscard]] const char* status_class_name(StatusClass c);
 
-/// The horizontal protection level in sigmas of the covariance's major axis: a Gaussian horizontal error with that
-/// covariance exceeds it with probability at most exp(-6^2 / 2) ~ 1.5e-8 per epoch (|e|^2 <= lambda_max chi-square(2)).
-inline constexpr double kProtectionLevelSigmas = 6.0;
-
 struct StatusStats {
   int epochs = 0;                      ///< solutions of this class
   double fraction_of_solved = 0.0;     ///< epochs / epochs with a solution
@@ -88,7 +84,8 @@ struct SolutionStats {
   int epochs_with_covariance = 0;
   int beyond_3_sigma_horizontal = 0;
   /// Integrity: of those, the solutions whose horizontal error exceeds their horizontal protection level
-  /// HPL = kProtectionLevelSigmas sqrt(lambda_max(C)) (misleading information).
+  /// HPL = core::horizontal_protection_level_m(C), the level output with the solution but in the frame at the truth
+  /// (misleading information).
   int beyond_protection_level = 0;
   double wrong_fix_threshold_m = 0.0;
   std::optional<double> time_to_first_fix_s;  ///< from the first epoch to the first fixed solution

@@ -18,13 +18,14 @@
 //              "solutions": lost solutions},
 //    "links": {"rover": LINK, "base": LINK}, LINK = {"dropped_bytes", "failures", "bad_frames", "undecodable"}
 //              (the receiver's and the correction stream's losses so far; zeros for files),
-//    "solution": {"seq","status","lat_deg","lon_deg","height_m","n_sats","pruned":["G05",...],"ratio"} or null,
-//    "alignment": {"rmse_m","eigen_ratio","lever_arm_m":[x,y,z]} or null}
+//    "solution": {"seq","status","lat_deg","lon_deg","height_m","n_sats","pruned":["G05",...],"ratio","hpl_m","vpl_m"}
+//    or null, "alignment": {"rmse_m","eigen_ratio","lever_arm_m":[x,y,z]} or null}
 // Percentiles are over the last `window` samples (nearest rank).
 
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -70,6 +71,8 @@ struct SolutionSample {
   double height_m = 0.0;
   int n_sats = 0;
   double ratio = 0.0;
+  double hpl_m = std::numeric_limits<double>::quiet_NaN();  ///< horizontal protection level (NaN: none)
+  double vpl_m = std::numeric_limits<double>::quiet_NaN();  ///< vertical protection level (NaN: none)
   std::vector<std::string> pruned;
   std::int64_t arrival_ns = 0;    ///< rover arrival at ingest
   std::int64_t base_send_ns = 0;  ///< 0: none
