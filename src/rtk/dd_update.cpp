@@ -144,12 +144,14 @@ std::vector<DdRow> gated_rows(const FilterState& state, std::vector<SingleDiff>&
     }
     if (pass) verdicts[k] = untestable ? Verdict::FollowsCode : Verdict::Passes;
   }
+  const bool whole_signal = gate != nullptr && gate->refuses_signal_with_code();
   std::vector<DdRow> kept;
   kept.reserve(rows.size());
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const DdRow& row = rows[k];
-    const bool passes = verdicts[k] == Verdict::Passes ||
-                        (verdicts[k] == Verdict::FollowsCode && code_refused[static_cast<std::size_t>(row.sd)] == 0);
+    const bool code_ok = code_refused[static_cast<std::size_t>(row.sd)] == 0;
+    const bool passes = (verdicts[k] == Verdict::Passes && (code_ok || !whole_signal || !row.phase)) ||
+                        (verdicts[k] == Verdict::FollowsCode && code_ok);
     if (passes) {
       kept.push_back(row);
       continue;

@@ -54,7 +54,7 @@ variant ionosphere-from-others rtk.iono_residual_sigma_per_10km_m=0.005
 variant cascaded-partial-hold rtk.partial_hold_sigma_cyc=0.2
 variant code-multipath-states rtk.code_multipath_sigma_m=0.5 rtk.code_multipath_correlation_s=60
 variant no-pruning fusion.gate=off rtk.partial_ar=false
-variant paper-alone fusion.gate=paper fusion.coarse_alignment=false fusion.heading_state=false \
+variant paper-alone fusion.gate=paper fusion.gate_nlos_sigmas=0 fusion.coarse_alignment=false fusion.heading_state=false \
   fusion.vio_sigma_factor=1 fusion.vio_scale_state=false fusion.vio_stitch_resets=false fusion.vio_max_bridged_gap_s=0 \
   fusion.false_fix_guard=false fusion.max_fix_sigma_m=1000 fusion.max_prior_rejections=1000000 \
   fusion.integrity_check=false fusion.heading_free_fill_in=false fusion.output_sigma_floor_h_m=0 \

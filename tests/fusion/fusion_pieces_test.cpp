@@ -81,6 +81,7 @@ struct Row {
 TEST(FusionPieces, TheGatesAreFiveTimesTheMotionAndChiSquare) {
   GateOptions paper;
   paper.kind = GateKind::Paper;
+  paper.nlos_sigmas = 0.0;                     // the paper's gate alone
   const VioInnovationGates gates(paper, 0.4);  // 5 x 0.4 m = 2 m
   ASSERT_TRUE(gates.max_phase_innovation_m().has_value());
   EXPECT_DOUBLE_EQ(*gates.max_phase_innovation_m(), 2.0);
@@ -91,6 +92,7 @@ TEST(FusionPieces, TheGatesAreFiveTimesTheMotionAndChiSquare) {
   EXPECT_DOUBLE_EQ(*VioInnovationGates(paper, 0.01).max_phase_innovation_m(), paper.min_gate_m);
   GateOptions chi;
   chi.kind = GateKind::ChiSquare;
+  chi.nlos_sigmas = 0.0;
   const VioInnovationGates chi_gates(chi, 0.4);
   EXPECT_FALSE(chi_gates.max_phase_innovation_m().has_value());
   EXPECT_FALSE(chi_gates.passes(Row(false, 5.0, 0.44).view(0.56)));  // 5 > 4 sqrt(1)
@@ -98,6 +100,27 @@ TEST(FusionPieces, TheGatesAreFiveTimesTheMotionAndChiSquare) {
   GateOptions off;
   off.kind = GateKind::Off;
   EXPECT_TRUE(VioInnovationGates(off, 0.4).passes(Row(true, 1e6, 0.0).view(0.0)));
+}
+
+TEST(FusionPieces, TheNlosGateRefusesCodesLongerThanThePriorAllowsAndTheirSignals) {
+  GateOptions options;  // the shipped set-up: both gates and NLOS at 3 sigma
+  const VioInnovationGates gates(options, 0.4);
+  EXPECT_TRUE(gates.refuses_signal_with_code());
+  EXPECT_FALSE(gates.passes(Row(false, 3.1, 0.44).view(0.56)));  // 3.1 > 3 sqrt(1) upward: a reflection's extra path
+  EXPECT_TRUE(gates.passes(Row(false, -3.1, 0.44).view(0.56)));  // downward: no reflection, the chi-square judges
+  EXPECT_TRUE(gates.passes(Row(false, 2.9, 0.44).view(0.56)));
+  EXPECT_TRUE(gates.passes(Row(true, 0.04, 0.0004).view(1e-5)));  // phase rows are not judged by it
+  GateOptions off = options;
+  off.nlos_sigmas = 0.0;
+  EXPECT_FALSE(VioInnovationGates(off, 0.4).refuses_signal_with_code());
+  EXPECT_TRUE(VioInnovationGates(off, 0.4).passes(Row(false, 3.1, 0.44).view(0.56)));
+  GateOptions none = options;
+  none.kind = GateKind::Off;  // no gate at all: no NLOS gate either
+  EXPECT_FALSE(VioInnovationGates(none, 0.4).refuses_signal_with_code());
+  EXPECT_TRUE(VioInnovationGates(none, 0.4).passes(Row(false, 30.0, 0.44).view(0.56)));
+  GateOptions bad = options;
+  bad.nlos_sigmas = -1.0;
+  EXPECT_NE(bad.validate().find("gate_nlos_sigmas"), std::string::npos);
 }
 
 rtk::RtkEpoch aided_epoch(const Eigen::Vector3d& float_offset_m) {

@@ -1,6 +1,7 @@
 // The DD measurement update (rtk/dd_update.hpp) on a synthetic epoch (synthetic_epoch.hpp): the rows against the
 // highest satellite, the update that brings the prior to the truth, the post-fit rejection of a code outlier, the
-// fixed innovation limits and an injected gate (a phase its prediction cannot test taking its code's verdict), and
+// fixed innovation limits and an injected gate (a phase its prediction cannot test taking its code's verdict; every
+// phase of a signal whose code is refused, for a gate that refuses signals with their code), and
 // float validation when more outliers remain than may be rejected.
 
 #include "canyon/rtk/dd_update.hpp"
@@ -170,6 +171,19 @@ TEST(DdUpdate, APhaseItsPredictionCannotTestTakesTheVerdictOfItsCode) {
   EXPECT_EQ(std::count(rejected.begin(), rejected.end(), known.sds[4].sat), 1);  // its code only
   EXPECT_EQ(k.phase_rows, 7);
   EXPECT_TRUE(known.sds[4].fixable);
+  // A gate that refuses a signal with its code (the fusion's NLOS gate): the testable phase goes as well.
+  struct RefuseFarCodeAndItsSignal final : InnovationGate {
+    [[nodiscard]] bool passes(const DdInnovation& row) const override {
+      return row.phase() || std::abs(row.innovation_m()) < 5.0;
+    }
+    [[nodiscard]] bool refuses_signal_with_code() const override { return true; }
+  } whole;
+  testing::SyntheticEpoch nlos = reflected_epoch(0.01, 0.0);
+  rejected.clear();
+  const DdUpdateResult n = dd_measurement_update(nlos.state, nlos.sds, RtkOptions{}, &whole, rejected);
+  EXPECT_EQ(std::count(rejected.begin(), rejected.end(), nlos.sds[4].sat), 2);  // its code and its phase
+  EXPECT_EQ(n.phase_rows, 6);
+  EXPECT_FALSE(nlos.sds[4].fixable);
 }
 
 }  // namespace

@@ -62,6 +62,9 @@ class InnovationGate {
  public:
   virtual ~InnovationGate() = default;
   [[nodiscard]] virtual bool passes(const DdInnovation& row) const = 0;
+  /// True: a signal whose code row it refuses loses its phase rows as well, even those its prediction could test (a
+  /// code far beyond the prior marks a reflected signal, whose phase carries the same extra path).
+  [[nodiscard]] virtual bool refuses_signal_with_code() const { return false; }
 };
 
 struct DdUpdateResult {
