@@ -53,6 +53,7 @@ variant slip-repair-and-reacquisition rtk.ambiguity_prior_max_sigma_cyc=0.15 rtk
 variant ionosphere-from-others rtk.iono_residual_sigma_per_10km_m=0.005
 variant cascaded-partial-hold rtk.partial_hold_sigma_cyc=0.2
 variant code-multipath-states rtk.code_multipath_sigma_m=0.5 rtk.code_multipath_correlation_s=60
+variant no-nlos-gate fusion.gate_nlos_sigmas=0
 variant no-pruning fusion.gate=off rtk.partial_ar=false
 variant paper-alone fusion.gate=paper fusion.gate_nlos_sigmas=0 fusion.coarse_alignment=false fusion.heading_state=false \
   fusion.vio_sigma_factor=1 fusion.vio_scale_state=false fusion.vio_stitch_resets=false fusion.vio_max_bridged_gap_s=0 \
@@ -69,11 +70,12 @@ declare -A what=(
   [ionosphere-from-others]="+ a new ionosphere state from the others' (0.005 m per 10 km)"
   [cascaded-partial-hold]="+ cascaded partial fixing held in the filter (0.2 cycles)"
   [code-multipath-states]="+ time-correlated code multipath states (0.5 m, 60 s)"
+  [no-nlos-gate]="without NLOS by VIO consistency (gate_nlos_sigmas 0)"
   [no-pruning]="without pruning (no gate, no ILS pruning)"
   [canyon-rtk]="without VIO: canyon rtk (config/rtk.yaml)"
   [paper-alone]="the paper's method alone (5x motion gate, ratio 3, Algorithm 1, no additions)"
 )
-rows=${ROWS:-shipped slip-repair slip-repair-and-reacquisition ionosphere-from-others cascaded-partial-hold code-multipath-states no-pruning canyon-rtk paper-alone}
+rows=${ROWS:-shipped slip-repair slip-repair-and-reacquisition ionosphere-from-others cascaded-partial-hold code-multipath-states no-nlos-gate no-pruning canyon-rtk paper-alone}
 failed=0
 : >"$tmp/table.md"
 for row in $rows; do
