@@ -65,26 +65,25 @@ struct FusionStats {
   int float_rejected_no_phase = 0;
   int float_rejected_post_fit = 0;
   int float_rejected_prior = 0;
-  int guard_epochs = 0;      ///< epochs in which the false-fix guard refused at least one candidate
-  int guard_candidates = 0;  ///< candidate fixes it refused
-  int gated_rows = 0;        ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
-  int ambiguities_from_position =
-      0;                            ///< new or slipped ambiguities started from the position (rtk/ambiguity_prior.hpp)
-  int cn0_screened = 0;             ///< signals removed by the C/N0 screen
-  int undetermined_fix_epochs = 0;  ///< epochs in which a fix was refused for its position sigma
-  int too_few_to_fix = 0;           ///< aided epochs whose fixable ambiguities came from fewer than 4 satellites
-  int float_inconsistent = 0;       ///< aided epochs whose float failed the RTK filter's float consistency test
-  int ar_pruned_epochs = 0;         ///< fixes obtained after pruning satellites by their ILS residual
-  int reanchored = 0;               ///< floats taken after max_prior_rejections (the prior had drifted)
-  int widened = 0;                  ///< priors widened after gate_conflict_epochs
-  double heading_folded_rad = 0.0;  ///< heading state: the sum of the heading corrections folded into T_EO
-  double heading_sigma_rad = 0.0;   ///< heading state: the heading error's sigma after the last aided epoch
-  double scale_error = 0.0;         ///< scale state: the VIO's scale error after the last aided epoch (relative)
-  double scale_sigma = 0.0;         ///< scale state: its sigma
-  int integrity_restarts = 0;       ///< integrity check: restarts from the single point
-  int heading_free = 0;             ///< heading-free fill-in: epochs it filled
-  AlignmentStats alignment;         ///< tries, rejections, accepted alignments, the calibration
-  std::vector<std::string> notes;   ///< VIO segments, integrity restarts
+  int guard_epochs = 0;               ///< epochs in which the false-fix guard refused at least one candidate
+  int guard_candidates = 0;           ///< candidate fixes it refused
+  int gated_rows = 0;                 ///< DD rows (code and phase) rejected by the innovation gates and post-fit checks
+  int ambiguities_from_position = 0;  ///< ambiguities started from the position (rtk/ambiguity_prior.hpp)
+  int cn0_screened = 0;               ///< signals removed by the C/N0 screen
+  int undetermined_fix_epochs = 0;    ///< epochs in which a fix was refused for its position sigma
+  int too_few_to_fix = 0;             ///< aided epochs whose fixable ambiguities came from fewer than 4 satellites
+  int float_inconsistent = 0;         ///< aided epochs whose float failed the RTK filter's float consistency test
+  int ar_pruned_epochs = 0;           ///< fixes obtained after pruning satellites by their ILS residual
+  int reanchored = 0;                 ///< floats taken after max_prior_rejections (the prior had drifted)
+  int widened = 0;                    ///< priors widened after gate_conflict_epochs
+  double heading_folded_rad = 0.0;    ///< heading state: the sum of the heading corrections folded into T_EO
+  double heading_sigma_rad = 0.0;     ///< heading state: the heading error's sigma after the last aided epoch
+  double scale_error = 0.0;           ///< scale state: the VIO's scale error after the last aided epoch (relative)
+  double scale_sigma = 0.0;           ///< scale state: its sigma
+  int integrity_restarts = 0;         ///< integrity check: restarts from the single point
+  int heading_free = 0;               ///< heading-free fill-in: epochs it filled
+  AlignmentStats alignment;           ///< tries, rejections, accepted alignments, the calibration
+  std::vector<std::string> notes;     ///< VIO segments, integrity restarts
 };
 
 class FusionEngine {

@@ -13,7 +13,8 @@
 // resolution fixes it once its success rate allows (the prior is in its covariance). A slip is thereby repaired (the
 // state restarts at the old value plus the integer jump) and a re-acquired signal starts converged.
 //
-// It is used only while the start's sigma, sqrt(w' P w + var(e)) / lambda_s in cycles, is at most max_sigma_cyc
+// It is used only while the start's DD sigma (of N_s - (lambda_r / lambda_s) N_r: the terms above without N_r's, whose
+// variance is the receiver's phase bias common to the group, never observed; in cycles) is at most max_sigma_cyc
 // (lambda/6.6, 0.15 cycles: the integer is then right with a probability of 99.9 %) and, between two signals of one
 // wavelength (an integer DD ambiguity), while the start lies within two of its sigmas of an integer (a reflected phase
 // or a position that is off lands anywhere in the cycle); otherwise the code start stays.
