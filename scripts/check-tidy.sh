@@ -2,22 +2,48 @@
 # Run clang-tidy 14 with the repository's .clang-tidy over the project's own .cpp files (tracked files under src/
 # and tests/, never generated code) using BUILD_DIR/compile_commands.json, two files at a time. Fails on any
 # diagnostic.
-# Usage: scripts/check-tidy.sh BUILD_DIR [all|src]
+# Usage: scripts/check-tidy.sh BUILD_DIR [all|src] [--changed-since COMMIT] [--record]
 #   all (default): src/ and tests/; src: the product's sources only (scripts/test.sh's default: tidy over the test
 #   files, which expand GoogleTest and Eigen, takes another 8 minutes on 2 cores and would push CI past 30 minutes).
+#   --changed-since COMMIT: check only the files whose tidy result can differ from COMMIT's, where a full run passed:
+#     a .cpp is checked when it or any header it includes (the build's own dependency list, `ninja -t deps`)
+#     differs from COMMIT in the working tree. Everything is checked when COMMIT is unknown, the build is not a
+#     Ninja build, or what changed can alter every file (.clang-tidy, a CMakeLists.txt or .cmake file (flags), idl/
+#     (generated headers)). clang-tidy reads nothing else (this script only picks the files), so the answer equals a
+#     full run's.
+#   --record: after a full run that passes on a clean working tree, write HEAD to .ci/tidy-clean, the COMMIT that
+#     scripts/test.sh passes to --changed-since (for src/ only).
 set -euo pipefail
 
-if (($# < 1 || $# > 2)) || [[ "${2:-all}" != all && "${2:-all}" != src ]]; then
-  echo "usage: $0 BUILD_DIR [all|src]" >&2
+usage() {
+  echo "usage: $0 BUILD_DIR [all|src] [--changed-since COMMIT] [--record]" >&2
   exit 2
-fi
-scope="${2:-all}"
+}
+(($# >= 1)) || usage
+build_arg="$1"
+shift
+scope=all
+since=""
+record=0
+while (($# > 0)); do
+  case "$1" in
+    all | src) scope="$1" ;;
+    --changed-since)
+      (($# >= 2)) || usage
+      since="$2"
+      shift
+      ;;
+    --record) record=1 ;;
+    *) usage ;;
+  esac
+  shift
+done
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-if [[ ! -d "$1" ]]; then
-  echo "check-tidy: error: build directory $1 does not exist; build first (scripts/build.sh)" >&2
+if [[ ! -d "${build_arg}" ]]; then
+  echo "check-tidy: error: build directory ${build_arg} does not exist; build first (scripts/build.sh)" >&2
   exit 1
 fi
-build_dir="$(cd "$1" && pwd)"
+build_dir="$(cd "${build_arg}" && pwd)"
 jobs="${CANYON_TIDY_JOBS:-2}"
 
 if [[ ! -f "${build_dir}/compile_commands.json" ]]; then
@@ -29,6 +55,56 @@ if [[ -z "${clang_tidy}" ]]; then
   echo "check-tidy: error: clang-tidy not found (scripts/setup.sh installs it)" >&2
   exit 1
 fi
+
+# changed_files COMMIT FILE...: the FILEs whose tidy result can differ from COMMIT's, one per line; or, when every
+# file must be checked, the line "full: REASON" followed by all FILEs.
+changed_files() {
+  local commit="$1"
+  shift
+  local reason=""
+  local changed=()
+  if ! git -C "${repo_root}" cat-file -e "${commit}^{commit}" 2> /dev/null; then
+    reason="commit ${commit} is not in this clone"
+  elif [[ ! -f "${build_dir}/build.ninja" ]]; then
+    reason="not a Ninja build: no dependency list"
+  else
+    mapfile -t changed < <(git -C "${repo_root}" diff --name-only "${commit}" -- &&
+      git -C "${repo_root}" ls-files --others --exclude-standard)
+    local path
+    for path in "${changed[@]}"; do
+      if [[ "${path}" == .clang-tidy || "${path}" == */CMakeLists.txt || "${path}" == CMakeLists.txt ||
+        "${path}" == *.cmake || "${path}" == idl/* ]]; then
+        reason="${path} changed since ${commit}"
+        break
+      fi
+    done
+  fi
+  if [[ -n "${reason}" ]]; then
+    echo "full: ${reason}"
+    printf '%s\n' "$@"
+    return
+  fi
+  # ninja -t deps: "OBJECT: #deps N ..." then one indented dependency per line, the source first.
+  (cd "${build_dir}" && ninja -t deps) | python3 -c '
+import sys
+repo, changed, wanted = sys.argv[1], set(sys.argv[2].split("\n")), sys.argv[3:]
+changed = {repo + "/" + p for p in changed if p}
+hit, deps = set(), []
+def close():
+    if deps and changed.intersection(deps):
+        hit.add(deps[0])
+for line in sys.stdin:
+    if line.startswith((" ", "\t")):
+        deps.append(line.strip())
+    else:
+        close()
+        deps = []
+close()
+for f in wanted:
+    if f in hit or f in changed:
+        print(f)
+' "${repo_root}" "$(printf '%s\n' "${changed[@]}")" "$@"
+}
 
 cd "${repo_root}"
 # Tracked sources that the build compiles; a tracked file that no target builds yet is reported and skipped.
@@ -45,6 +121,17 @@ for file in "${tracked[@]}"; do
     echo "check-tidy: skipping ${file}: not in the compilation database (no target builds it)"
   fi
 done
+full=1
+if [[ -n "${since}" ]]; then
+  mapfile -t files < <(changed_files "${since}" "${files[@]}")
+  if [[ "${files[0]:-}" == full:* ]]; then
+    echo "check-tidy: checking every file (${files[0]#full: })"
+    files=("${files[@]:1}")
+  else
+    full=0
+    echo "check-tidy: ${#files[@]} files can differ from ${since}, where every file passed"
+  fi
+fi
 if ((${#files[@]} == 0)); then
   echo "check-tidy: no files to check"
   exit 0
@@ -76,3 +163,11 @@ if ((status != 0)) || grep -qE '(warning|error): ' "${log}"; then
   exit 1
 fi
 echo "check-tidy: ${#files[@]} files OK"
+if ((record == 1)); then
+  if ((full == 0)) || [[ -n "$(git status --porcelain)" ]]; then
+    echo "check-tidy: not recorded: --record needs a full run on a clean working tree" >&2
+    exit 1
+  fi
+  git rev-parse HEAD > .ci/tidy-clean
+  echo "check-tidy: recorded $(cat .ci/tidy-clean) in .ci/tidy-clean (commit it)"
+fi
