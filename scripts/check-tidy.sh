@@ -2,21 +2,21 @@
 # Run clang-tidy 14 with the repository's .clang-tidy over the project's own .cpp files (tracked files under src/
 # and tests/, never generated code) using BUILD_DIR/compile_commands.json, two files at a time. Fails on any
 # diagnostic.
-# Usage: scripts/check-tidy.sh BUILD_DIR [all|src] [--changed-since COMMIT] [--record]
+# Usage: scripts/check-tidy.sh BUILD_DIR [all|src] [--since-record FILE] [--record FILE]
 #   all (default): src/ and tests/; src: the product's sources only (scripts/test.sh's default: tidy over the test
 #   files, which expand GoogleTest and Eigen, takes another 8 minutes on 2 cores and would push CI past 30 minutes).
-#   --changed-since COMMIT: check only the files whose tidy result can differ from COMMIT's, where a full run passed:
-#     a .cpp is checked when it or any header it includes (the build's own dependency list, `ninja -t deps`)
-#     differs from COMMIT in the working tree. Everything is checked when COMMIT is unknown, the build is not a
-#     Ninja build, or what changed can alter every file (.clang-tidy, a CMakeLists.txt or .cmake file (flags), idl/
-#     (generated headers)). clang-tidy reads nothing else (this script only picks the files), so the answer equals a
-#     full run's.
-#   --record: after a full run that passes on a clean working tree, write HEAD to .ci/tidy-clean, the COMMIT that
-#     scripts/test.sh passes to --changed-since (for src/ only).
+#   --since-record FILE: check only the files whose tidy result can differ from that of the commit FILE names (its
+#     first line), where a full run passed: a .cpp is checked when it or any header it includes (the build's own
+#     dependency list, `ninja -t deps`) differs from that commit in the working tree, or when its compile command
+#     differs from the one FILE holds for it (flags, defines, include paths). Everything is checked when the commit
+#     is unknown, the build is not a Ninja build, or .clang-tidy or idl/ (generated headers) changed. clang-tidy reads
+#     nothing else (this script only picks the files), so the answer equals a full run's.
+#   --record FILE: after a full run that passes on a clean working tree, write HEAD and each file's compile command
+#     (a hash) to FILE; scripts/test.sh uses .ci/tidy-clean (for src/ only).
 set -euo pipefail
 
 usage() {
-  echo "usage: $0 BUILD_DIR [all|src] [--changed-since COMMIT] [--record]" >&2
+  echo "usage: $0 BUILD_DIR [all|src] [--since-record FILE] [--record FILE]" >&2
   exit 2
 }
 (($# >= 1)) || usage
@@ -24,16 +24,20 @@ build_arg="$1"
 shift
 scope=all
 since=""
-record=0
+record=""
 while (($# > 0)); do
   case "$1" in
     all | src) scope="$1" ;;
-    --changed-since)
+    --since-record)
       (($# >= 2)) || usage
-      since="$2"
+      since="$(realpath -m "$2")"
       shift
       ;;
-    --record) record=1 ;;
+    --record)
+      (($# >= 2)) || usage
+      record="$(realpath -m "$2")"
+      shift
+      ;;
     *) usage ;;
   esac
   shift
@@ -56,15 +60,16 @@ if [[ -z "${clang_tidy}" ]]; then
   exit 1
 fi
 
-# changed_files COMMIT FILE...: the FILEs whose tidy result can differ from COMMIT's, one per line; or, when every
-# file must be checked, the line "full: REASON" followed by all FILEs.
+# changed_files RECORD FILE...: the FILEs whose tidy result can differ from the RECORD's commit's, one per line; or,
+# when every file must be checked, the line "full: REASON" followed by all FILEs.
 changed_files() {
-  local commit="$1"
+  local record_file="$1"
   shift
-  local reason=""
+  local commit reason=""
+  commit="$(head -n 1 "${record_file}" 2> /dev/null || true)"
   local changed=()
-  if ! git -C "${repo_root}" cat-file -e "${commit}^{commit}" 2> /dev/null; then
-    reason="commit ${commit} is not in this clone"
+  if [[ -z "${commit}" ]] || ! git -C "${repo_root}" cat-file -e "${commit}^{commit}" 2> /dev/null; then
+    reason="commit '${commit}' of ${record_file} is not in this clone"
   elif [[ ! -f "${build_dir}/build.ninja" ]]; then
     reason="not a Ninja build: no dependency list"
   else
@@ -72,8 +77,7 @@ changed_files() {
       git -C "${repo_root}" ls-files --others --exclude-standard)
     local path
     for path in "${changed[@]}"; do
-      if [[ "${path}" == .clang-tidy || "${path}" == */CMakeLists.txt || "${path}" == CMakeLists.txt ||
-        "${path}" == *.cmake || "${path}" == idl/* ]]; then
+      if [[ "${path}" == .clang-tidy || "${path}" == idl/* ]]; then
         reason="${path} changed since ${commit}"
         break
       fi
@@ -85,25 +89,8 @@ changed_files() {
     return
   fi
   # ninja -t deps: "OBJECT: #deps N ..." then one indented dependency per line, the source first.
-  (cd "${build_dir}" && ninja -t deps) | python3 -c '
-import sys
-repo, changed, wanted = sys.argv[1], set(sys.argv[2].split("\n")), sys.argv[3:]
-changed = {repo + "/" + p for p in changed if p}
-hit, deps = set(), []
-def close():
-    if deps and changed.intersection(deps):
-        hit.add(deps[0])
-for line in sys.stdin:
-    if line.startswith((" ", "\t")):
-        deps.append(line.strip())
-    else:
-        close()
-        deps = []
-close()
-for f in wanted:
-    if f in hit or f in changed:
-        print(f)
-' "${repo_root}" "$(printf '%s\n' "${changed[@]}")" "$@"
+  (cd "${build_dir}" && ninja -t deps) | python3 "${repo_root}/scripts/tidy_changed.py" "${repo_root}" "${build_dir}" \
+    "${record_file}" "$(printf '%s\n' "${changed[@]}")" "$@"
 }
 
 cd "${repo_root}"
@@ -129,7 +116,7 @@ if [[ -n "${since}" ]]; then
     files=("${files[@]:1}")
   else
     full=0
-    echo "check-tidy: ${#files[@]} files can differ from ${since}, where every file passed"
+    echo "check-tidy: ${#files[@]} files can differ from $(head -n 1 "${since}"), where every file passed (${since})"
   fi
 fi
 if ((${#files[@]} == 0)); then
@@ -163,11 +150,12 @@ if ((status != 0)) || grep -qE '(warning|error): ' "${log}"; then
   exit 1
 fi
 echo "check-tidy: ${#files[@]} files OK"
-if ((record == 1)); then
+if [[ -n "${record}" ]]; then
   if ((full == 0)) || [[ -n "$(git status --porcelain)" ]]; then
     echo "check-tidy: not recorded: --record needs a full run on a clean working tree" >&2
     exit 1
   fi
-  git rev-parse HEAD > .ci/tidy-clean
-  echo "check-tidy: recorded $(cat .ci/tidy-clean) in .ci/tidy-clean (commit it)"
+  python3 "${repo_root}/scripts/tidy_changed.py" --record "${repo_root}" "${build_dir}" "$(git rev-parse HEAD)" \
+    "${files[@]}" > "${record}"
+  echo "check-tidy: recorded $(head -n 1 "${record}") and ${#files[@]} compile commands in ${record} (commit it)"
 fi

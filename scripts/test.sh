@@ -156,7 +156,7 @@ tidy_args=("${build_dir}" src)
 if [[ "${CANYON_TIDY_TESTS:-0}" == 1 ]]; then
   tidy_args=("${build_dir}" all) # the recorded commit vouches for src/ only
 elif [[ "${CANYON_TIDY_FULL:-0}" != 1 && -f "${repo_root}/.ci/tidy-clean" ]]; then
-  tidy_args+=(--changed-since "$(< "${repo_root}/.ci/tidy-clean")")
+  tidy_args+=(--since-record "${repo_root}/.ci/tidy-clean")
 fi
 if ! phase check-tidy bash "${scripts}/check-tidy.sh" "${tidy_args[@]}"; then
   failed=$((failed + 1))
