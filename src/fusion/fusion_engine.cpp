@@ -257,7 +257,7 @@ FusionEpoch FusionEngine::finish_solved_epoch() {
   count_fix_refusals();
   FusionEpoch out;
   stats_.gated_rows += static_cast<int>(epoch.rejected.size());
-  stats_.ambiguities_from_position += epoch.ambiguities_from_position;
+  stats_.ambiguities_from_position += static_cast<int>(epoch.ambiguities_from_position.size());
   out.hdop = epoch.hdop;
   out.note = epoch.note;
   if (aiding_) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace canyon::rtk {
 namespace {
@@ -87,37 +88,44 @@ double dd_start_value(const FilterState& state, const Start& start, int referenc
 
 /// The start is usable: its DD sigma at most max_sigma_cyc and, between signals of one wavelength (an integer DD
 /// ambiguity), its value within two of its sigmas of an integer (a reflected phase or a position that is off lands
-/// anywhere in the cycle; a good start there with a probability of 95 %).
-bool usable_start(const FilterState& state, const Start& start, int reference_index, bool integer,
-                  double max_sigma_cyc) {
+/// anywhere in the cycle; a good start there with a probability of 95 %). Its DD value and sigma when usable.
+std::optional<AmbiguityStart> usable_start(const FilterState& state, const Start& start, int reference_index,
+                                           bool integer, double max_sigma_cyc) {
   const double variance = dd_start_variance(state, start, reference_index);
-  if (variance > max_sigma_cyc * max_sigma_cyc) return false;
-  if (!integer) return true;
+  if (variance > max_sigma_cyc * max_sigma_cyc) return std::nullopt;
   const double value = dd_start_value(state, start, reference_index);
-  return std::abs(value - std::round(value)) <= 2.0 * std::sqrt(variance);
+  if (integer && std::abs(value - std::round(value)) > 2.0 * std::sqrt(variance)) return std::nullopt;
+  AmbiguityStart usable;
+  usable.dd_cyc = value;
+  usable.dd_sigma_cyc = std::sqrt(variance);
+  usable.integer = integer;
+  return usable;
 }
 
 }  // namespace
 
-int start_ambiguities_from_position(FilterState& state, const std::vector<SingleDiff>& sds,
-                                    const std::vector<StateKey>& added, double max_sigma_cyc) {
-  if (!(max_sigma_cyc > 0.0)) return 0;
-  int started = 0;
+std::vector<AmbiguityStart> start_ambiguities_from_position(FilterState& state, const std::vector<SingleDiff>& sds,
+                                                            const std::vector<StateKey>& added, double max_sigma_cyc) {
+  std::vector<AmbiguityStart> started;
+  if (!(max_sigma_cyc > 0.0)) return started;
   for (const StateKey& key : added) {
     if (key.ionosphere() || key.code_bias() || !state.has(key)) continue;
     const SingleDiff* sd = find_sd(sds, key);
     if (sd == nullptr || !core::has_value(sd->phase_m)) continue;
     const SingleDiff* ref = reference_for(state, sds, *sd, added);
     if (ref == nullptr) continue;
+    const StateKey reference{ref->sat, ref->frequency};
     // The terms do not hold the new state itself: the start is the same with or without it.
-    if (!usable_start(state, start_against(state, *sd, *ref), state.index({ref->sat, ref->frequency}),
-                      sd->wavelength_m == ref->wavelength_m, max_sigma_cyc)) {
-      continue;
-    }
+    std::optional<AmbiguityStart> usable = usable_start(state, start_against(state, *sd, *ref), state.index(reference),
+                                                        sd->wavelength_m == ref->wavelength_m, max_sigma_cyc);
+    if (!usable) continue;
     state.remove(key);  // the code start; the indices after it move, so the terms are formed again
     const Start start = start_against(state, *sd, *ref);
     state.add_combination(key, start.terms, start.residual_variance, start.offset);
-    ++started;
+    usable->key = key;
+    usable->reference = reference;
+    usable->wavelength_m = sd->wavelength_m;
+    started.push_back(*usable);
   }
   return started;
 }

@@ -59,7 +59,7 @@ Case make_case(double offset_m, double extra_cyc, double sigma_m) {
 TEST(AmbiguityPrior, StartIsTheDdPhaseRowSolvedWithItsCovariances) {
   Case c = make_case(0.004, 0.0, 0.01);
   const Eigen::Matrix3d P_pp = c.state.position_covariance_E_m2();
-  ASSERT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.15), 1);
+  ASSERT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.15).size(), 1U);
   const int s = c.state.index({gps(7), 0});
   const int r = c.state.index({gps(3), 0});
   ASSERT_GE(s, 0);
@@ -78,22 +78,22 @@ TEST(AmbiguityPrior, StartIsTheDdPhaseRowSolvedWithItsCovariances) {
 TEST(AmbiguityPrior, UncertainPositionKeepsTheCodeStart) {
   Case c = make_case(0.0, 0.0, 0.5);  // 50 cm per axis: several cycles
   const double code_start = c.state.x()[c.state.index({gps(7), 0})];
-  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.15), 0);
+  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.15).size(), 0U);
   EXPECT_EQ(c.state.x()[c.state.index({gps(7), 0})], code_start);
   EXPECT_EQ(c.state.P()(c.state.index({gps(7), 0}), c.state.index({gps(7), 0})), 900.0);
 }
 
 TEST(AmbiguityPrior, PhaseOffAnIntegerKeepsTheCodeStart) {
   Case c = make_case(0.0, 0.4, 0.005);  // a reflection's extra path: 0.4 cycles beyond the integer
-  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.15), 0);
+  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.15).size(), 0U);
   EXPECT_EQ(c.state.P()(c.state.index({gps(7), 0}), c.state.index({gps(7), 0})), 900.0);
 }
 
 TEST(AmbiguityPrior, NothingWithoutAHeldReferenceOrWhenOff) {
   Case c = make_case(0.0, 0.0, 0.005);
-  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.0), 0);
+  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(7), 0}}, 0.0).size(), 0U);
   // The reference new this epoch as well: no held ambiguity to start from.
-  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(3), 0}, {gps(7), 0}}, 0.15), 0);
+  EXPECT_EQ(start_ambiguities_from_position(c.state, c.sds, {{gps(3), 0}, {gps(7), 0}}, 0.15).size(), 0U);
 }
 
 }  // namespace

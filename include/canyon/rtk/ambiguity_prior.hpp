@@ -29,10 +29,21 @@
 
 namespace canyon::rtk {
 
+/// One ambiguity started from the position: its DD start against the reference (for the report of repairs against
+/// a simulator's true integers, tests/bench/repair_truth.cpp).
+struct AmbiguityStart {
+  StateKey key;
+  StateKey reference;
+  double dd_cyc = 0.0;        ///< N_s - (lambda_r / lambda_s) N_r as started (cycles)
+  double dd_sigma_cyc = 0.0;  ///< its sigma
+  double wavelength_m = 0.0;  ///< lambda_s
+  bool integer = false;       ///< lambda_r == lambda_s: the DD ambiguity is an integer
+};
+
 /// Restarts each ambiguity of `added` (keys new to the filter this epoch, started from their code) from the
 /// position as above where the start's sigma is at most `max_sigma_cyc`; `sds` are the epoch's single differences
-/// (state indices need not be assigned). Returns how many were started from the position.
-int start_ambiguities_from_position(FilterState& state, const std::vector<SingleDiff>& sds,
-                                    const std::vector<StateKey>& added, double max_sigma_cyc);
+/// (state indices need not be assigned). Returns the ambiguities started from the position.
+std::vector<AmbiguityStart> start_ambiguities_from_position(FilterState& state, const std::vector<SingleDiff>& sds,
+                                                            const std::vector<StateKey>& added, double max_sigma_cyc);
 
 }  // namespace canyon::rtk

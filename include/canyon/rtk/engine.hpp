@@ -30,6 +30,7 @@
 #include "canyon/core/result.hpp"
 #include "canyon/core/solution.hpp"
 #include "canyon/gnss/ephemeris.hpp"
+#include "canyon/rtk/ambiguity_prior.hpp"
 #include "canyon/rtk/ambiguity_resolution.hpp"
 #include "canyon/rtk/ambiguity_states.hpp"
 #include "canyon/rtk/dd_update.hpp"
@@ -43,11 +44,12 @@ namespace canyon::rtk {
 
 /// One epoch's result.
 struct RtkEpoch {
-  core::Solution solution;            ///< status Fixed, Float or Single
-  int num_fixed_ambiguities = 0;      ///< DD ambiguities in the accepted fix (0 if not fixed)
-  int num_dd_measurements = 0;        ///< DD phase measurements used in the update
-  int num_dd_code_measurements = 0;   ///< DD code measurements used in the update
-  int ambiguities_from_position = 0;  ///< new or slipped ambiguities started from the position (ambiguity_prior.hpp)
+  core::Solution solution;           ///< status Fixed, Float or Single
+  int num_fixed_ambiguities = 0;     ///< DD ambiguities in the accepted fix (0 if not fixed)
+  int num_dd_measurements = 0;       ///< DD phase measurements used in the update
+  int num_dd_code_measurements = 0;  ///< DD code measurements used in the update
+  /// new or slipped ambiguities started from the position (ambiguity_prior.hpp)
+  std::vector<AmbiguityStart> ambiguities_from_position;
   std::vector<core::SatelliteId> rejected;  ///< satellites whose measurements failed the innovation gate
   std::string note;                         ///< why the epoch is not fixed, if it is not (for --verbose)
   double hdop = 0.0;                        ///< of the single-point geometry, for NMEA GGA

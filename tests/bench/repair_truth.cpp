@@ -1,0 +1,292 @@
+// bench_repair_truth: ambiguities started from the held position (slip repair and re-acquisition,
+// rtk/ambiguity_prior.hpp) judged against the simulator's true integers, by the length of the gap they bridged.
+//
+//   bench_repair_truth SCENARIO.yaml SEED... [--config FILE] [--max-sigma CYC] [--duration S]
+//
+// Each seed of the scenario is simulated in memory with its signal truth, and fused with FILE (default
+// config/fusion.yaml) with rtk.ambiguity_prior_max_sigma_cyc set to CYC (default 0.15, lambda/6.6) where the file
+// leaves it off. The VIO is the simulator's pose stream on GPST (no time-sync file). For every ambiguity started from
+// the position between signals of one wavelength (an integer DD ambiguity), the true DD integer is
+//   (N_rover,s - N_base,s) - (N_rover,r - N_base,r)
+// from the simulator's channel ambiguities, and the start is wrong when it rounds to another integer. The gap is the
+// time since the signal's last rover phase before this epoch: 0 for a slip while tracked (loss-of-lock bit), the
+// outage otherwise; "new" when the signal had no phase before. A start on a signal (or against a reference) received
+// only by reflection has no true integer in this sense (its phase carries the excess path) and is counted apart.
+// Prints one table per run (all seeds) and a last line "repairs=N wrong=M wrong_pct=X nlos=K".
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
+
+#include "canyon/config/process_config.hpp"
+#include "canyon/config/scenario_config.hpp"
+#include "canyon/fusion/fusion_engine.hpp"
+#include "canyon/fusion/vio_track.hpp"
+#include "canyon/gnss/ephemeris.hpp"
+#include "canyon/rtk/ambiguity_prior.hpp"
+#include "canyon/sim/simulator.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using canyon::core::GpsTime;
+using canyon::core::SatelliteId;
+using canyon::core::SignalCode;
+
+struct Args {
+  std::string scenario;
+  std::vector<std::uint64_t> seeds;
+  std::string config = std::string(CANYON_SOURCE_DIR) + "/config/fusion.yaml";
+  double max_sigma_cyc = 0.15;
+  double duration_s = 0.0;  // 0: the scenario's
+};
+
+std::optional<Args> parse_args(int argc, char** argv) {
+  Args args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (a == "--config" && has_value) {
+      args.config = argv[++i];
+    } else if (a == "--max-sigma" && has_value) {
+      args.max_sigma_cyc = std::atof(argv[++i]);
+    } else if (a == "--duration" && has_value) {
+      args.duration_s = std::atof(argv[++i]);
+    } else if (args.scenario.empty()) {
+      args.scenario = a;
+    } else {
+      char* end = nullptr;
+      const unsigned long long seed = std::strtoull(a.c_str(), &end, 10);
+      if (end == a.c_str() || *end != '\0') return std::nullopt;
+      args.seeds.push_back(seed);
+    }
+  }
+  if (args.scenario.empty() || args.seeds.empty() || !(args.max_sigma_cyc > 0.0)) return std::nullopt;
+  return args;
+}
+
+/// The gap bins of the table: a slip while tracked, then outages by length, then a signal never seen before.
+constexpr int kBins = 6;
+const char* const kBinNames[kBins] = {"slip (tracked)", "gap <= 1 s", "gap 1-5 s", "gap 5-30 s", "gap > 30 s", "new"};
+int gap_bin(std::optional<double> gap_s) {
+  if (!gap_s) return 5;
+  if (*gap_s <= 0.0) return 0;
+  if (*gap_s <= 1.0) return 1;
+  if (*gap_s <= 5.0) return 2;
+  if (*gap_s <= 30.0) return 3;
+  return 4;
+}
+
+struct Tally {
+  int starts = 0;      // integer DD starts
+  int judged = 0;      // both signals in line of sight with a true integer
+  int wrong = 0;       // rounds to another integer than the true one
+  int nlos = 0;        // the signal or its reference received by reflection
+  int no_truth = 0;    // the simulator's truth lacks a signal (base epoch without it)
+  int fractional = 0;  // between wavelengths (GLONASS): no integer
+  double max_error_cyc = 0.0;
+};
+
+const canyon::sim::SignalTruth* find_signal(const canyon::sim::EpochTruth& epoch, const SatelliteId& sat,
+                                            double wavelength_m) {
+  for (const canyon::sim::SignalTruth& s : epoch.signals) {
+    if (s.sat == sat && std::abs(s.wavelength_m - wavelength_m) < 1e-9) return &s;
+  }
+  return nullptr;
+}
+
+/// One start judged against the truth at rover epoch `rover` and base epoch `base`.
+void judge(const canyon::rtk::AmbiguityStart& start, const canyon::sim::EpochTruth& rover,
+           const canyon::sim::EpochTruth& base, Tally& tally) {
+  if (!start.integer) {
+    ++tally.fractional;
+    return;
+  }
+  ++tally.starts;
+  // An integer DD ambiguity: the reference has the signal's wavelength.
+  const double lambda_m = start.wavelength_m;
+  const canyon::sim::SignalTruth* rs = find_signal(rover, start.key.sat, lambda_m);
+  const canyon::sim::SignalTruth* bs = find_signal(base, start.key.sat, lambda_m);
+  const canyon::sim::SignalTruth* rr = find_signal(rover, start.reference.sat, lambda_m);
+  const canyon::sim::SignalTruth* br = find_signal(base, start.reference.sat, lambda_m);
+  if (rs == nullptr || bs == nullptr || rr == nullptr || br == nullptr) {
+    ++tally.no_truth;
+    return;
+  }
+  if (!rs->direct || !rr->direct || !bs->direct || !br->direct) {
+    ++tally.nlos;
+    return;
+  }
+  const double truth =
+      static_cast<double>((rs->ambiguity_cyc - bs->ambiguity_cyc) - (rr->ambiguity_cyc - br->ambiguity_cyc));
+  ++tally.judged;
+  const double error_cyc = start.dd_cyc - truth;
+  tally.max_error_cyc = std::max(tally.max_error_cyc, std::abs(error_cyc));
+  if (std::round(start.dd_cyc) != truth) {
+    ++tally.wrong;
+    std::printf("  wrong start at %.1f s: %s frequency %d against %s: %.3f cycles (sigma %.3f), true %.0f\n", rover.t_s,
+                start.key.sat.to_string().c_str(), start.key.frequency, start.reference.sat.to_string().c_str(),
+                start.dd_cyc, start.dd_sigma_cyc, truth);
+  }
+}
+
+std::size_t base_epoch_for(const canyon::sim::Simulation& sim, std::size_t base, const GpsTime& t) {
+  while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - t <= 0.05) ++base;
+  return base;
+}
+
+std::vector<canyon::fusion::VioTrackSample> track_samples(const canyon::sim::VioRun& vio, const GpsTime& start) {
+  std::vector<canyon::fusion::VioTrackSample> samples;
+  for (const canyon::sim::VioSample& v : vio.poses) {
+    canyon::fusion::VioTrackSample t;
+    t.t_s = v.time - start;
+    t.T_OI = v.T_OI;
+    t.P = v.covariance;
+    t.C_previous = v.cross_previous;
+    samples.push_back(t);
+  }
+  return samples;
+}
+
+/// The last time each rover signal (satellite, wavelength) had phase, before the epoch being processed.
+using LastPhase = std::map<std::pair<SatelliteId, SignalCode>, GpsTime>;
+
+std::optional<double> gap_of(const LastPhase& last, const canyon::sim::EpochTruth& rover,
+                             const canyon::rtk::AmbiguityStart& start, const GpsTime& t, double epoch_s) {
+  const canyon::sim::SignalTruth* s = find_signal(rover, start.key.sat, start.wavelength_m);
+  if (s == nullptr) return std::nullopt;
+  const auto it = last.find({s->sat, s->code});
+  if (it == last.end()) return std::nullopt;
+  const double gap_s = (t - it->second) - epoch_s;
+  return gap_s < 0.5 * epoch_s ? 0.0 : gap_s;
+}
+
+void note_phases(const canyon::core::ObsEpoch& epoch, LastPhase& last) {
+  for (const canyon::core::SatelliteObs& sat : epoch.sats) {
+    for (const canyon::core::SignalObs& s : sat.signals) {
+      if (canyon::core::has_value(s.carrier_phase_cyc)) last[{sat.sat, s.code}] = epoch.time;
+    }
+  }
+}
+
+bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins]) {
+  auto scenario = canyon::config::load_scenario(args.scenario);
+  if (!scenario) {
+    std::fprintf(stderr, "bench_repair_truth: %s\n", scenario.error().to_string().c_str());
+    return false;
+  }
+  scenario->seed = seed;
+  if (args.duration_s > 0.0) scenario->duration_s = args.duration_s;
+  auto config = canyon::config::load_process_config(args.config);
+  if (!config) {
+    std::fprintf(stderr, "bench_repair_truth: %s\n", config.error().to_string().c_str());
+    return false;
+  }
+  if (!(config->rtk.ambiguity_prior_max_sigma_cyc > 0.0))
+    config->rtk.ambiguity_prior_max_sigma_cyc = args.max_sigma_cyc;
+  const fs::path dir = fs::temp_directory_path() / ("canyon_repair_truth_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  canyon::sim::SimulationOptions options;
+  options.keep_signal_truth = true;
+  auto sim = canyon::sim::simulate(*scenario, (dir / "nav.rnx").string(), options);
+  fs::remove_all(dir);
+  if (!sim) {
+    std::fprintf(stderr, "bench_repair_truth: %s\n", sim.error().to_string().c_str());
+    return false;
+  }
+  const canyon::gnss::EphemerisStore eph(sim->nav);
+  const GpsTime start = scenario->start;
+  canyon::fusion::FusionEngine engine(config->fusion, config->rtk, eph, sim->base_p_E_m,
+                                      canyon::fusion::VioTrack::from_samples(track_samples(sim->vio, start), start));
+  const double epoch_s = 1.0 / scenario->rover_rate_hz;
+  LastPhase last;
+  std::size_t base = 0;
+  for (std::size_t k = 0; k < sim->rover.epochs.size(); ++k) {
+    const canyon::core::ObsEpoch& e = sim->rover.epochs[k];
+    base = base_epoch_for(*sim, base, e.time);
+    auto out = engine.process(e, &sim->base.epochs[base]);
+    if (out) {
+      for (const canyon::rtk::AmbiguityStart& s : out->rtk.ambiguities_from_position) {
+        const int bin = gap_bin(gap_of(last, sim->rover.truth[k], s, e.time, epoch_s));
+        judge(s, sim->rover.truth[k], sim->base.truth[base], tallies[bin]);
+      }
+    }
+    note_phases(e, last);
+  }
+  return true;
+}
+
+void print_table(const Tally (&tallies)[kBins]) {
+  std::printf("%-16s %8s %8s %8s %9s %8s %8s %10s %14s\n", "gap", "starts", "judged", "wrong", "wrong_pct", "nlos",
+              "no_truth", "fractional", "max_err_cyc");
+  Tally all;
+  for (int b = 0; b < kBins; ++b) {
+    const Tally& t = tallies[b];
+    std::printf("%-16s %8d %8d %8d %8.2f%% %8d %8d %10d %14.3f\n", kBinNames[b], t.starts, t.judged, t.wrong,
+                t.judged > 0 ? 100.0 * t.wrong / t.judged : 0.0, t.nlos, t.no_truth, t.fractional, t.max_error_cyc);
+    all.starts += t.starts;
+    all.judged += t.judged;
+    all.wrong += t.wrong;
+    all.nlos += t.nlos;
+    all.no_truth += t.no_truth;
+    all.fractional += t.fractional;
+    all.max_error_cyc = std::max(all.max_error_cyc, t.max_error_cyc);
+  }
+  std::printf("repairs=%d judged=%d wrong=%d wrong_pct=%.2f nlos=%d fractional=%d max_err_cyc=%.3f\n", all.starts,
+              all.judged, all.wrong, all.judged > 0 ? 100.0 * all.wrong / all.judged : 0.0, all.nlos, all.fractional,
+              all.max_error_cyc);
+}
+
+/// Runs every seed and prints the tables; false on an error (printed).
+bool run(const Args& args) {
+  Tally tallies[kBins];
+  for (const std::uint64_t seed : args.seeds) {
+    Tally seed_tallies[kBins];
+    std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
+    if (!run_seed(args, seed, seed_tallies)) return false;
+    int starts = 0, wrong = 0;
+    for (int b = 0; b < kBins; ++b) {
+      starts += seed_tallies[b].starts;
+      wrong += seed_tallies[b].wrong;
+      tallies[b].starts += seed_tallies[b].starts;
+      tallies[b].judged += seed_tallies[b].judged;
+      tallies[b].wrong += seed_tallies[b].wrong;
+      tallies[b].nlos += seed_tallies[b].nlos;
+      tallies[b].no_truth += seed_tallies[b].no_truth;
+      tallies[b].fractional += seed_tallies[b].fractional;
+      tallies[b].max_error_cyc = std::max(tallies[b].max_error_cyc, seed_tallies[b].max_error_cyc);
+    }
+    std::printf("seed %llu: %d integer starts, %d wrong\n", static_cast<unsigned long long>(seed), starts, wrong);
+    std::fflush(stdout);
+  }
+  print_table(tallies);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Args> args = parse_args(argc, argv);
+  if (!args) {
+    std::fprintf(stderr,
+                 "usage: bench_repair_truth SCENARIO.yaml SEED... [--config FILE] [--max-sigma CYC] [--duration S]\n");
+    return 2;
+  }
+  try {
+    return run(*args) ? 0 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_repair_truth: error: %s\n", e.what());
+    return 1;
+  }
+}
