@@ -1,18 +1,24 @@
 // bench_repair_truth: ambiguities started from the held position (slip repair and re-acquisition,
-// rtk/ambiguity_prior.hpp) judged against the simulator's true integers, by the length of the gap they bridged.
+// rtk/ambiguity_prior.hpp) judged against the simulator's true integers, by the length of the gap they bridged; and
+// the time to a correct fix after each blockage.
 //
 //   bench_repair_truth SCENARIO.yaml SEED... [--config FILE] [--max-sigma CYC] [--duration S]
 //
 // Each seed of the scenario is simulated in memory with its signal truth, and fused with FILE (default
 // config/fusion.yaml) with rtk.ambiguity_prior_max_sigma_cyc set to CYC (default 0.15, lambda/6.6) where the file
-// leaves it off. The VIO is the simulator's pose stream on GPST (no time-sync file). For every ambiguity started from
-// the position between signals of one wavelength (an integer DD ambiguity), the true DD integer is
+// leaves it off (--max-sigma 0: the file as it is). The VIO is the simulator's pose stream on GPST (no time-sync
+// file). For every ambiguity started from the position between signals of one wavelength (an integer DD ambiguity),
+// the true DD integer is
 //   (N_rover,s - N_base,s) - (N_rover,r - N_base,r)
 // from the simulator's channel ambiguities, and the start is wrong when it rounds to another integer. The gap is the
 // time since the signal's last rover phase before this epoch: 0 for a slip while tracked (loss-of-lock bit), the
 // outage otherwise; "new" when the signal had no phase before. A start on a signal (or against a reference) received
 // only by reflection has no true integer in this sense (its phase carries the excess path) and is counted apart.
-// Prints one table per run (all seeds) and a last line "repairs=N wrong=M wrong_pct=X nlos=K".
+// A blockage is a run of at least 1 s below the line-of-sight ceiling (fewer than 5 satellites in line of sight, by
+// the truth) after an epoch above it; its time to a correct fix runs from its end to the first fixed epoch within
+// 10 cm (3D) of the truth before the next blockage.
+// Prints, over all seeds, the table of starts, a line "repairs=N wrong=M wrong_pct=X nlos=K ..." and a line
+// "blockages=N ... time_to_correct_fix_s median=X p90=Y max=Z".
 
 #include <algorithm>
 #include <cmath>
@@ -72,7 +78,7 @@ std::optional<Args> parse_args(int argc, char** argv) {
       args.seeds.push_back(seed);
     }
   }
-  if (args.scenario.empty() || args.seeds.empty() || !(args.max_sigma_cyc > 0.0)) return std::nullopt;
+  if (args.scenario.empty() || args.seeds.empty() || !(args.max_sigma_cyc >= 0.0)) return std::nullopt;
   return args;
 }
 
@@ -180,7 +186,57 @@ void note_phases(const canyon::core::ObsEpoch& epoch, LastPhase& last) {
   }
 }
 
-bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins]) {
+/// Blockages: runs of at least kMinBlockage_s below the line-of-sight ceiling (fewer than
+/// sim::kLineOfSightCeilingSatellites satellites in line of sight) after an epoch above it, and the time from each
+/// one's end to the first correct fix (fixed, within 10 cm 3D of the truth) before the next one begins.
+constexpr double kMinBlockage_s = 1.0;
+struct Blockages {
+  int count = 0;
+  int fixed_before = 0;  // a correct fix in the 5 s before the blockage
+  int not_refixed = 0;   // no correct fix before the next blockage or the end
+  std::vector<double> refix_s;
+};
+
+int line_of_sight_satellites(const canyon::sim::EpochTruth& epoch) {
+  std::vector<SatelliteId> sats;
+  for (const canyon::sim::SignalTruth& s : epoch.signals) {
+    if (s.direct && std::find(sats.begin(), sats.end(), s.sat) == sats.end()) sats.push_back(s.sat);
+  }
+  return static_cast<int>(sats.size());
+}
+
+/// The blockages of one run from its per-epoch line-of-sight verdicts and correct fixes.
+void tally_blockages(const std::vector<bool>& clear, const std::vector<bool>& correct, double epoch_s, Blockages& out) {
+  const auto min_epochs = static_cast<std::size_t>(std::lround(kMinBlockage_s / epoch_s));
+  std::vector<std::pair<std::size_t, std::size_t>> runs;  // [first blocked epoch, first clear epoch after it)
+  for (std::size_t k = 1; k < clear.size(); ++k) {
+    if (clear[k] || !clear[k - 1]) continue;
+    std::size_t end = k;
+    while (end < clear.size() && !clear[end]) ++end;
+    if (end - k >= min_epochs && end < clear.size()) runs.emplace_back(k, end);
+  }
+  const auto before_s = static_cast<std::size_t>(std::lround(5.0 / epoch_s));
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const auto [first, end] = runs[r];
+    ++out.count;
+    const std::size_t from = first > before_s ? first - before_s : 0;
+    if (std::find(correct.begin() + static_cast<std::ptrdiff_t>(from),
+                  correct.begin() + static_cast<std::ptrdiff_t>(first),
+                  true) != correct.begin() + static_cast<std::ptrdiff_t>(first)) {
+      ++out.fixed_before;
+    }
+    const std::size_t limit = r + 1 < runs.size() ? runs[r + 1].first : correct.size();
+    std::size_t j = end;
+    while (j < limit && !correct[j]) ++j;
+    if (j < limit) {
+      out.refix_s.push_back(static_cast<double>(j - end) * epoch_s);
+    } else {
+      ++out.not_refixed;
+    }
+  }
+}
+
+bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blockages& blockages) {
   auto scenario = canyon::config::load_scenario(args.scenario);
   if (!scenario) {
     std::fprintf(stderr, "bench_repair_truth: %s\n", scenario.error().to_string().c_str());
@@ -211,11 +267,15 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins]) {
                                       canyon::fusion::VioTrack::from_samples(track_samples(sim->vio, start), start));
   const double epoch_s = 1.0 / scenario->rover_rate_hz;
   LastPhase last;
+  std::vector<bool> clear, correct;
   std::size_t base = 0;
   for (std::size_t k = 0; k < sim->rover.epochs.size(); ++k) {
     const canyon::core::ObsEpoch& e = sim->rover.epochs[k];
     base = base_epoch_for(*sim, base, e.time);
     auto out = engine.process(e, &sim->base.epochs[base]);
+    clear.push_back(line_of_sight_satellites(sim->rover.truth[k]) >= canyon::sim::kLineOfSightCeilingSatellites);
+    correct.push_back(out && out->solution.status == canyon::core::SolutionStatus::Fixed &&
+                      (out->solution.p_E_m - sim->truth[k].p_E_m).norm() <= 0.10);
     if (out) {
       for (const canyon::rtk::AmbiguityStart& s : out->rtk.ambiguities_from_position) {
         const int bin = gap_bin(gap_of(last, sim->rover.truth[k], s, e.time, epoch_s));
@@ -224,7 +284,24 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins]) {
     }
     note_phases(e, last);
   }
+  tally_blockages(clear, correct, epoch_s, blockages);
   return true;
+}
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const auto i = static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
+  return values[i];
+}
+
+void print_blockages(const Blockages& b) {
+  const auto refixed = static_cast<int>(b.refix_s.size());
+  std::printf(
+      "blockages=%d (>= %.0f s below the line-of-sight ceiling) fixed_before=%d refixed=%d not_refixed=%d "
+      "time_to_correct_fix_s median=%.1f p90=%.1f max=%.1f\n",
+      b.count, kMinBlockage_s, b.fixed_before, refixed, b.not_refixed, percentile(b.refix_s, 0.5),
+      percentile(b.refix_s, 0.9), percentile(b.refix_s, 1.0));
 }
 
 void print_table(const Tally (&tallies)[kBins]) {
@@ -251,10 +328,11 @@ void print_table(const Tally (&tallies)[kBins]) {
 /// Runs every seed and prints the tables; false on an error (printed).
 bool run(const Args& args) {
   Tally tallies[kBins];
+  Blockages blockages;
   for (const std::uint64_t seed : args.seeds) {
     Tally seed_tallies[kBins];
     std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
-    if (!run_seed(args, seed, seed_tallies)) return false;
+    if (!run_seed(args, seed, seed_tallies, blockages)) return false;
     int starts = 0, wrong = 0;
     for (int b = 0; b < kBins; ++b) {
       starts += seed_tallies[b].starts;
@@ -271,6 +349,7 @@ bool run(const Args& args) {
     std::fflush(stdout);
   }
   print_table(tallies);
+  print_blockages(blockages);
   return true;
 }
 
