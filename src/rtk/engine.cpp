@@ -260,6 +260,16 @@ void RtkEngine::conclude_fixes() {
     sol.P_E_m2 = fix.P_E_m2;
     sol.status = core::SolutionStatus::Fixed;
     out.num_fixed_ambiguities = static_cast<int>(fix.a_fix.size());
+    if (!fix.combinations) {
+      for (std::size_t i = 0; i < fix.dd.size(); ++i) {
+        FixedAmbiguity fixed{state_.key_at(fix.dd[i].first), state_.key_at(fix.dd[i].second),
+                             fix.a_fix[static_cast<Eigen::Index>(i)]};
+        for (const SingleDiff& sd : pending_->sds) {
+          if (sd.sat == fixed.sat.sat && sd.frequency == fixed.sat.frequency) fixed.wavelength_m = sd.wavelength_m;
+        }
+        out.fixed_ambiguities.push_back(fixed);
+      }
+    }
     out.ar_pruned = fix.pruned;
     resolver_.commit(fix, state_);
   }

@@ -2,13 +2,13 @@
 // rtk/ambiguity_prior.hpp) judged against the simulator's true integers, by the length of the gap they bridged; and
 // the time to a correct fix after each blockage.
 //
-//   bench_repair_truth SCENARIO.yaml SEED... [--config FILE] [--max-sigma CYC] [--duration S]
+//   bench_repair_truth SCENARIO.yaml SEED... [--mode fusion|rtk] [--config FILE] [--max-sigma CYC] [--duration S]
 //
 // Each seed of the scenario is simulated in memory with its signal truth, and fused with FILE (default
-// config/fusion.yaml) with rtk.ambiguity_prior_max_sigma_cyc set to CYC (default 0.15, lambda/6.6) where the file
-// leaves it off (--max-sigma 0: the file as it is). The VIO is the simulator's pose stream on GPST (no time-sync
-// file). For every ambiguity started from the position between signals of one wavelength (an integer DD ambiguity),
-// the true DD integer is
+// config/fusion.yaml; with --mode rtk canyon rtk without the VIO, default config/rtk.yaml) with
+// rtk.ambiguity_prior_max_sigma_cyc set to CYC (default 0.15, lambda/6.6) where the file leaves it off (--max-sigma 0:
+// the file as it is). The VIO is the simulator's pose stream on GPST (no time-sync file). For every ambiguity started
+// from the position between signals of one wavelength (an integer DD ambiguity), the true DD integer is
 //   (N_rover,s - N_base,s) - (N_rover,r - N_base,r)
 // from the simulator's channel ambiguities, and the start is wrong when it rounds to another integer. The gap is the
 // time since the signal's last rover phase before this epoch: 0 for a slip while tracked (loss-of-lock bit), the
@@ -17,7 +17,11 @@
 // A blockage is a run of at least 1 s below the line-of-sight ceiling (fewer than 5 satellites in line of sight, by
 // the truth) after an epoch above it; its time to a correct fix runs from its end to the first fixed epoch within
 // 10 cm (3D) of the truth before the next blockage.
-// Prints, over all seeds, the table of starts, a line "repairs=N wrong=M wrong_pct=X nlos=K ..." and a line
+// Every output fixed epoch's DD integers (the RTK filter's accepted fix) are judged the same way: right when each
+// one between line-of-sight signals equals the true integer, and the epoch is counted by that and by its position
+// (within 10 cm of the truth or beyond).
+// Prints, over all seeds, the table of starts, a line "repairs=N wrong=M wrong_pct=X nlos=K ...", a line
+// "fixed_epochs=N within_10cm: integers_right=A integers_wrong=B; beyond_10cm: ..." and a line
 // "blockages=N ... time_to_correct_fix_s median=X p90=Y max=Z".
 
 #include <algorithm>
@@ -41,6 +45,7 @@
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/gnss/ephemeris.hpp"
 #include "canyon/rtk/ambiguity_prior.hpp"
+#include "canyon/rtk/engine.hpp"
 #include "canyon/sim/simulator.hpp"
 
 namespace {
@@ -53,9 +58,10 @@ using canyon::core::SignalCode;
 struct Args {
   std::string scenario;
   std::vector<std::uint64_t> seeds;
-  std::string config = std::string(CANYON_SOURCE_DIR) + "/config/fusion.yaml";
+  std::string config;  // default: config/fusion.yaml, or config/rtk.yaml with --mode rtk
   double max_sigma_cyc = 0.15;
   double duration_s = 0.0;  // 0: the scenario's
+  bool rtk = false;         // canyon rtk (no VIO) instead of fusion
 };
 
 std::optional<Args> parse_args(int argc, char** argv) {
@@ -67,6 +73,10 @@ std::optional<Args> parse_args(int argc, char** argv) {
       args.config = argv[++i];
     } else if (a == "--max-sigma" && has_value) {
       args.max_sigma_cyc = std::atof(argv[++i]);
+    } else if (a == "--mode" && has_value) {
+      const std::string mode = argv[++i];
+      if (mode != "rtk" && mode != "fusion") return std::nullopt;
+      args.rtk = mode == "rtk";
     } else if (a == "--duration" && has_value) {
       args.duration_s = std::atof(argv[++i]);
     } else if (args.scenario.empty()) {
@@ -79,6 +89,9 @@ std::optional<Args> parse_args(int argc, char** argv) {
     }
   }
   if (args.scenario.empty() || args.seeds.empty() || !(args.max_sigma_cyc >= 0.0)) return std::nullopt;
+  if (args.config.empty()) {
+    args.config = std::string(CANYON_SOURCE_DIR) + (args.rtk ? "/config/rtk.yaml" : "/config/fusion.yaml");
+  }
   return args;
 }
 
@@ -197,6 +210,53 @@ struct Blockages {
   std::vector<double> refix_s;
 };
 
+/// Fixed epochs by their DD integers against the true ones and by their position against the truth.
+struct FixedTally {
+  int epochs = 0;
+  int correct_right = 0;   // within 10 cm, every judged integer right
+  int correct_wrong = 0;   // within 10 cm, some integer wrong
+  int off_right = 0;       // beyond 10 cm, every judged integer right
+  int off_wrong = 0;       // beyond 10 cm, some integer wrong
+  int on_reflections = 0;  // some integer of a reflected signal (no true integer), none judged wrong
+  int combinations = 0;    // fixed integer combinations, not listed
+};
+
+/// The verdict on one fixed epoch's integers: -1 some wrong, 0 some on a reflection (none wrong), 1 all right,
+/// 2 none listed (combinations).
+int judge_integers(const std::vector<canyon::rtk::FixedAmbiguity>& fixed, const canyon::sim::EpochTruth& rover,
+                   const canyon::sim::EpochTruth& base) {
+  if (fixed.empty()) return 2;
+  bool reflected = false;
+  for (const canyon::rtk::FixedAmbiguity& f : fixed) {
+    const canyon::sim::SignalTruth* rs = find_signal(rover, f.sat.sat, f.wavelength_m);
+    const canyon::sim::SignalTruth* bs = find_signal(base, f.sat.sat, f.wavelength_m);
+    const canyon::sim::SignalTruth* rr = find_signal(rover, f.reference.sat, f.wavelength_m);
+    const canyon::sim::SignalTruth* br = find_signal(base, f.reference.sat, f.wavelength_m);
+    if (rs == nullptr || bs == nullptr || rr == nullptr || br == nullptr || !rs->direct || !rr->direct || !bs->direct ||
+        !br->direct) {
+      reflected = true;
+      continue;
+    }
+    const double truth =
+        static_cast<double>((rs->ambiguity_cyc - bs->ambiguity_cyc) - (rr->ambiguity_cyc - br->ambiguity_cyc));
+    if (f.integer != truth) return -1;
+  }
+  return reflected ? 0 : 1;
+}
+
+void tally_fixed(int verdict, bool correct, FixedTally& t) {
+  ++t.epochs;
+  if (verdict == 2) {
+    ++t.combinations;
+  } else if (verdict == 0) {
+    ++t.on_reflections;
+  } else if (correct) {
+    ++(verdict == 1 ? t.correct_right : t.correct_wrong);
+  } else {
+    ++(verdict == 1 ? t.off_right : t.off_wrong);
+  }
+}
+
 int line_of_sight_satellites(const canyon::sim::EpochTruth& epoch) {
   std::vector<SatelliteId> sats;
   for (const canyon::sim::SignalTruth& s : epoch.signals) {
@@ -236,7 +296,13 @@ void tally_blockages(const std::vector<bool>& clear, const std::vector<bool>& co
   }
 }
 
-bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blockages& blockages) {
+/// One epoch's solution and the RTK filter's epoch under it.
+struct Step {
+  canyon::core::Solution solution;
+  canyon::rtk::RtkEpoch rtk;
+};
+
+bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blockages& blockages, FixedTally& fixed) {
   auto scenario = canyon::config::load_scenario(args.scenario);
   if (!scenario) {
     std::fprintf(stderr, "bench_repair_truth: %s\n", scenario.error().to_string().c_str());
@@ -244,7 +310,8 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
   }
   scenario->seed = seed;
   if (args.duration_s > 0.0) scenario->duration_s = args.duration_s;
-  auto config = canyon::config::load_process_config(args.config);
+  auto config = canyon::config::load_process_config(
+      args.config, args.rtk ? canyon::config::ProcessMode::Rtk : canyon::config::ProcessMode::Fusion);
   if (!config) {
     std::fprintf(stderr, "bench_repair_truth: %s\n", config.error().to_string().c_str());
     return false;
@@ -263,8 +330,25 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
   }
   const canyon::gnss::EphemerisStore eph(sim->nav);
   const GpsTime start = scenario->start;
-  canyon::fusion::FusionEngine engine(config->fusion, config->rtk, eph, sim->base_p_E_m,
-                                      canyon::fusion::VioTrack::from_samples(track_samples(sim->vio, start), start));
+  std::optional<canyon::fusion::FusionEngine> fusion;
+  std::optional<canyon::rtk::RtkEngine> rtk;
+  if (args.rtk) {
+    rtk.emplace(config->rtk, eph, sim->base_p_E_m);
+  } else {
+    fusion.emplace(config->fusion, config->rtk, eph, sim->base_p_E_m,
+                   canyon::fusion::VioTrack::from_samples(track_samples(sim->vio, start), start));
+  }
+  const auto step = [&](const canyon::core::ObsEpoch& rover,
+                        const canyon::core::ObsEpoch* base) -> std::optional<Step> {
+    if (rtk) {
+      auto out = rtk->process(rover, base);
+      if (!out) return std::nullopt;
+      return Step{out->solution, std::move(*out)};
+    }
+    auto out = fusion->process(rover, base);
+    if (!out) return std::nullopt;
+    return Step{out->solution, std::move(out->rtk)};
+  };
   const double epoch_s = 1.0 / scenario->rover_rate_hz;
   LastPhase last;
   std::vector<bool> clear, correct;
@@ -272,10 +356,15 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
   for (std::size_t k = 0; k < sim->rover.epochs.size(); ++k) {
     const canyon::core::ObsEpoch& e = sim->rover.epochs[k];
     base = base_epoch_for(*sim, base, e.time);
-    auto out = engine.process(e, &sim->base.epochs[base]);
+    const std::optional<Step> out = step(e, &sim->base.epochs[base]);
+    const bool is_fixed = out && out->solution.status == canyon::core::SolutionStatus::Fixed;
+    const bool within = is_fixed && (out->solution.p_E_m - sim->truth[k].p_E_m).norm() <= 0.10;
     clear.push_back(line_of_sight_satellites(sim->rover.truth[k]) >= canyon::sim::kLineOfSightCeilingSatellites);
-    correct.push_back(out && out->solution.status == canyon::core::SolutionStatus::Fixed &&
-                      (out->solution.p_E_m - sim->truth[k].p_E_m).norm() <= 0.10);
+    correct.push_back(within);
+    if (is_fixed) {
+      tally_fixed(judge_integers(out->rtk.fixed_ambiguities, sim->rover.truth[k], sim->base.truth[base]), within,
+                  fixed);
+    }
     if (out) {
       for (const canyon::rtk::AmbiguityStart& s : out->rtk.ambiguities_from_position) {
         const int bin = gap_bin(gap_of(last, sim->rover.truth[k], s, e.time, epoch_s));
@@ -293,6 +382,13 @@ double percentile(std::vector<double> values, double q) {
   std::sort(values.begin(), values.end());
   const auto i = static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
   return values[i];
+}
+
+void print_fixed(const FixedTally& t) {
+  std::printf(
+      "fixed_epochs=%d within_10cm: integers_right=%d integers_wrong=%d; beyond_10cm: integers_right=%d "
+      "integers_wrong=%d; on_reflections=%d combinations=%d\n",
+      t.epochs, t.correct_right, t.correct_wrong, t.off_right, t.off_wrong, t.on_reflections, t.combinations);
 }
 
 void print_blockages(const Blockages& b) {
@@ -329,10 +425,11 @@ void print_table(const Tally (&tallies)[kBins]) {
 bool run(const Args& args) {
   Tally tallies[kBins];
   Blockages blockages;
+  FixedTally fixed;
   for (const std::uint64_t seed : args.seeds) {
     Tally seed_tallies[kBins];
     std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
-    if (!run_seed(args, seed, seed_tallies, blockages)) return false;
+    if (!run_seed(args, seed, seed_tallies, blockages, fixed)) return false;
     int starts = 0, wrong = 0;
     for (int b = 0; b < kBins; ++b) {
       starts += seed_tallies[b].starts;
@@ -349,6 +446,7 @@ bool run(const Args& args) {
     std::fflush(stdout);
   }
   print_table(tallies);
+  print_fixed(fixed);
   print_blockages(blockages);
   return true;
 }
@@ -358,8 +456,10 @@ bool run(const Args& args) {
 int main(int argc, char** argv) {
   const std::optional<Args> args = parse_args(argc, argv);
   if (!args) {
-    std::fprintf(stderr,
-                 "usage: bench_repair_truth SCENARIO.yaml SEED... [--config FILE] [--max-sigma CYC] [--duration S]\n");
+    std::fprintf(
+        stderr,
+        "usage: bench_repair_truth SCENARIO.yaml SEED... [--mode fusion|rtk] [--config FILE] [--max-sigma CYC] "
+        "[--duration S]\n");
     return 2;
   }
   try {

@@ -42,10 +42,20 @@
 
 namespace canyon::rtk {
 
+/// A DD ambiguity of an accepted fix: N_sat - N_reference (state keys of the two SD ambiguities) = integer (cycles).
+struct FixedAmbiguity {
+  StateKey sat;
+  StateKey reference;
+  double integer = 0.0;
+  double wavelength_m = 0.0;  ///< of the satellite's signal (the reference's is the same in a fixable DD group)
+};
+
 /// One epoch's result.
 struct RtkEpoch {
-  core::Solution solution;           ///< status Fixed, Float or Single
-  int num_fixed_ambiguities = 0;     ///< DD ambiguities in the accepted fix (0 if not fixed)
+  core::Solution solution;        ///< status Fixed, Float or Single
+  int num_fixed_ambiguities = 0;  ///< DD ambiguities in the accepted fix (0 if not fixed)
+  /// The accepted fix's DD integers (empty if not fixed, or when it fixed integer combinations of them).
+  std::vector<FixedAmbiguity> fixed_ambiguities;
   int num_dd_measurements = 0;       ///< DD phase measurements used in the update
   int num_dd_code_measurements = 0;  ///< DD code measurements used in the update
   /// new or slipped ambiguities started from the position (ambiguity_prior.hpp)
