@@ -48,6 +48,8 @@
 #include "canyon/rtk/engine.hpp"
 #include "canyon/sim/simulator.hpp"
 
+#include "sim_vio_samples.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -125,6 +127,26 @@ const canyon::sim::SignalTruth* find_signal(const canyon::sim::EpochTruth& epoch
   return nullptr;
 }
 
+/// The true DD integer (N_rover,s - N_base,s) - (N_rover,r - N_base,r) of satellite s against reference r on the
+/// wavelength `lambda_m`, from the rover and base epochs' signal truth; none when a signal is missing or received
+/// only by reflection.
+struct TrueDd {
+  enum class Kind { Known, Missing, Reflected };
+  Kind kind = Kind::Missing;
+  double cycles = 0.0;
+};
+TrueDd true_dd(const canyon::sim::EpochTruth& rover, const canyon::sim::EpochTruth& base, const SatelliteId& s,
+               const SatelliteId& r, double lambda_m) {
+  const canyon::sim::SignalTruth* rs = find_signal(rover, s, lambda_m);
+  const canyon::sim::SignalTruth* bs = find_signal(base, s, lambda_m);
+  const canyon::sim::SignalTruth* rr = find_signal(rover, r, lambda_m);
+  const canyon::sim::SignalTruth* br = find_signal(base, r, lambda_m);
+  if (rs == nullptr || bs == nullptr || rr == nullptr || br == nullptr) return {};
+  if (!rs->direct || !rr->direct || !bs->direct || !br->direct) return {TrueDd::Kind::Reflected};
+  return {TrueDd::Kind::Known,
+          static_cast<double>((rs->ambiguity_cyc - bs->ambiguity_cyc) - (rr->ambiguity_cyc - br->ambiguity_cyc))};
+}
+
 /// One start judged against the truth at rover epoch `rover` and base epoch `base`.
 void judge(const canyon::rtk::AmbiguityStart& start, const canyon::sim::EpochTruth& rover,
            const canyon::sim::EpochTruth& base, Tally& tally) {
@@ -134,21 +156,16 @@ void judge(const canyon::rtk::AmbiguityStart& start, const canyon::sim::EpochTru
   }
   ++tally.starts;
   // An integer DD ambiguity: the reference has the signal's wavelength.
-  const double lambda_m = start.wavelength_m;
-  const canyon::sim::SignalTruth* rs = find_signal(rover, start.key.sat, lambda_m);
-  const canyon::sim::SignalTruth* bs = find_signal(base, start.key.sat, lambda_m);
-  const canyon::sim::SignalTruth* rr = find_signal(rover, start.reference.sat, lambda_m);
-  const canyon::sim::SignalTruth* br = find_signal(base, start.reference.sat, lambda_m);
-  if (rs == nullptr || bs == nullptr || rr == nullptr || br == nullptr) {
+  const TrueDd dd = true_dd(rover, base, start.key.sat, start.reference.sat, start.wavelength_m);
+  if (dd.kind == TrueDd::Kind::Missing) {
     ++tally.no_truth;
     return;
   }
-  if (!rs->direct || !rr->direct || !bs->direct || !br->direct) {
+  if (dd.kind == TrueDd::Kind::Reflected) {
     ++tally.nlos;
     return;
   }
-  const double truth =
-      static_cast<double>((rs->ambiguity_cyc - bs->ambiguity_cyc) - (rr->ambiguity_cyc - br->ambiguity_cyc));
+  const double truth = dd.cycles;
   ++tally.judged;
   const double error_cyc = start.dd_cyc - truth;
   tally.max_error_cyc = std::max(tally.max_error_cyc, std::abs(error_cyc));
@@ -158,24 +175,6 @@ void judge(const canyon::rtk::AmbiguityStart& start, const canyon::sim::EpochTru
                 start.key.sat.to_string().c_str(), start.key.frequency, start.reference.sat.to_string().c_str(),
                 start.dd_cyc, start.dd_sigma_cyc, truth);
   }
-}
-
-std::size_t base_epoch_for(const canyon::sim::Simulation& sim, std::size_t base, const GpsTime& t) {
-  while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - t <= 0.05) ++base;
-  return base;
-}
-
-std::vector<canyon::fusion::VioTrackSample> track_samples(const canyon::sim::VioRun& vio, const GpsTime& start) {
-  std::vector<canyon::fusion::VioTrackSample> samples;
-  for (const canyon::sim::VioSample& v : vio.poses) {
-    canyon::fusion::VioTrackSample t;
-    t.t_s = v.time - start;
-    t.T_OI = v.T_OI;
-    t.P = v.covariance;
-    t.C_previous = v.cross_previous;
-    samples.push_back(t);
-  }
-  return samples;
 }
 
 /// The last time each rover signal (satellite, wavelength) had phase, before the epoch being processed.
@@ -228,17 +227,12 @@ int judge_integers(const std::vector<canyon::rtk::FixedAmbiguity>& fixed, const 
   if (fixed.empty()) return 2;
   bool reflected = false;
   for (const canyon::rtk::FixedAmbiguity& f : fixed) {
-    const canyon::sim::SignalTruth* rs = find_signal(rover, f.sat.sat, f.wavelength_m);
-    const canyon::sim::SignalTruth* bs = find_signal(base, f.sat.sat, f.wavelength_m);
-    const canyon::sim::SignalTruth* rr = find_signal(rover, f.reference.sat, f.wavelength_m);
-    const canyon::sim::SignalTruth* br = find_signal(base, f.reference.sat, f.wavelength_m);
-    if (rs == nullptr || bs == nullptr || rr == nullptr || br == nullptr || !rs->direct || !rr->direct || !bs->direct ||
-        !br->direct) {
-      reflected = true;
+    const TrueDd dd = true_dd(rover, base, f.sat.sat, f.reference.sat, f.wavelength_m);
+    if (dd.kind != TrueDd::Kind::Known) {
+      reflected = true;  // no true integer (a missing signal counts here too)
       continue;
     }
-    const double truth =
-        static_cast<double>((rs->ambiguity_cyc - bs->ambiguity_cyc) - (rr->ambiguity_cyc - br->ambiguity_cyc));
+    const double truth = dd.cycles;
     if (f.integer != truth) return -1;
   }
   return reflected ? 0 : 1;
@@ -336,7 +330,7 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
     rtk.emplace(config->rtk, eph, sim->base_p_E_m);
   } else {
     fusion.emplace(config->fusion, config->rtk, eph, sim->base_p_E_m,
-                   canyon::fusion::VioTrack::from_samples(track_samples(sim->vio, start), start));
+                   canyon::fusion::VioTrack::from_samples(canyon::test::track_samples(sim->vio.poses, start), start));
   }
   const auto step = [&](const canyon::core::ObsEpoch& rover,
                         const canyon::core::ObsEpoch* base) -> std::optional<Step> {
@@ -355,7 +349,7 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
   std::size_t base = 0;
   for (std::size_t k = 0; k < sim->rover.epochs.size(); ++k) {
     const canyon::core::ObsEpoch& e = sim->rover.epochs[k];
-    base = base_epoch_for(*sim, base, e.time);
+    base = canyon::test::base_epoch_for(*sim, base, e.time);
     const std::optional<Step> out = step(e, &sim->base.epochs[base]);
     const bool is_fixed = out && out->solution.status == canyon::core::SolutionStatus::Fixed;
     const bool within = is_fixed && (out->solution.p_E_m - sim->truth[k].p_E_m).norm() <= 0.10;

@@ -33,10 +33,14 @@
 #include "canyon/sim/simulator.hpp"
 #include "canyon/sim/vio.hpp"
 
+#include "sim_vio_samples.hpp"
+
 namespace canyon::fusion {
 namespace {
 
 namespace fs = std::filesystem;
+using test::base_epoch_for;
+using test::track_samples;
 
 constexpr double kStep = 1e-6;
 
@@ -166,20 +170,6 @@ TEST(TimeBridgeTest, GpsClockStampsMapDirectly) {
 }
 
 // --- VIO track ------------------------------------------------------------------------------------------------------
-
-/// The simulator's VIO poses as track samples, timed from `start`.
-std::vector<VioTrackSample> track_samples(const std::vector<sim::VioSample>& poses, const core::GpsTime& start) {
-  std::vector<VioTrackSample> samples;
-  for (const sim::VioSample& v : poses) {
-    VioTrackSample t;
-    t.t_s = v.time - start;
-    t.T_OI = v.T_OI;
-    t.P = v.covariance;
-    t.C_previous = v.cross_previous;
-    samples.push_back(t);
-  }
-  return samples;
-}
 
 std::vector<VioTrackSample> straight_samples(int n, double dt_s, double speed_mps) {
   std::vector<VioTrackSample> s(static_cast<std::size_t>(n));
@@ -798,13 +788,6 @@ std::optional<Simulated> simulate_urban_severe(double duration_s, const std::str
                                                const sim::SimulationOptions& options = {},
                                                std::optional<std::uint64_t> seed = std::nullopt) {
   return simulate_scenario("urban-severe", duration_s, tag, options, seed);
-}
-
-/// The index of the base epoch to use with a rover epoch at `t`: the last within 0.05 s after it, moving on from
-/// `base` (the epochs come in time order).
-std::size_t base_epoch_for(const sim::Simulation& sim, std::size_t base, const core::GpsTime& t) {
-  while (base + 1 < sim.base.epochs.size() && sim.base.epochs[base + 1].time - t <= 0.05) ++base;
-  return base;
 }
 
 // --- C/N0 screen ----------------------------------------------------------------------------------------------------

@@ -23,6 +23,7 @@
 #include "canyon/rtk/engine.hpp"
 #include "canyon/sim/simulator.hpp"
 
+#include "sim_vio_samples.hpp"
 #include "test_support.hpp"
 
 namespace canyon {
@@ -76,20 +77,12 @@ CalibrationResult calibrate_square_walk(double length_m, const Eigen::Vector3d& 
   rtk::RtkOptions options;
   options.ionosphere = rtk::IonosphereModel::Estimate;
   rtk::RtkEngine engine(options, eph, sim->base_p_E_m);
-  std::vector<fusion::VioTrackSample> samples;
-  for (const sim::VioSample& v : sim->vio.poses) {
-    fusion::VioTrackSample t;
-    t.t_s = v.time - scenario->start;
-    t.T_OI = v.T_OI;
-    t.P = v.covariance;
-    t.C_previous = v.cross_previous;
-    samples.push_back(t);
-  }
-  const fusion::VioTrack track = fusion::VioTrack::from_samples(samples, scenario->start);
+  const fusion::VioTrack track =
+      fusion::VioTrack::from_samples(test::track_samples(sim->vio.poses, scenario->start), scenario->start);
   std::vector<fusion::AlignmentPoint> points;
   std::size_t base = 0;
   for (const core::ObsEpoch& e : sim->rover.epochs) {
-    while (base + 1 < sim->base.epochs.size() && sim->base.epochs[base + 1].time - e.time <= 0.05) ++base;
+    base = test::base_epoch_for(*sim, base, e.time);
     auto r = engine.process(e, &sim->base.epochs[base]);
     const auto pose = track.pose_at(e.time);
     if (r && pose && r->solution.status == core::SolutionStatus::Fixed) {
