@@ -249,6 +249,8 @@ Table<F> update_keys() {
                 fusion::gate_kind_name)},
       {"gate_motion_factor", "", "paper: 5 times the VIO incremental motion", at(&F::gates, &G::motion_factor)},
       {"min_gate_m", "m", "the motion gate is at least this (standing still)", at(&F::gates, &G::min_gate_m)},
+      {"max_gate_m", "m", "beyond the paper: the motion gate is at most this (speed-aware); 0: no cap",
+       at(&F::gates, &G::max_gate_m)},
       {"gate_sigmas", "sigmas", "chi-square gate", at(&F::gates, &G::sigmas)},
       {"gate_nlos_sigmas", "sigmas",
        "NLOS by VIO consistency: a DD code row beyond this many sigmas upward refuses its signal, phase too; 0: off",

@@ -21,13 +21,18 @@ std::string GateOptions::validate() const {
   if (!(motion_factor > 0.0) || !(min_gate_m > 0.0) || !(sigmas > 0.0)) {
     return "gate_motion_factor, min_gate_m and gate_sigmas must be > 0";
   }
+  if (!(max_gate_m == 0.0 || max_gate_m >= min_gate_m) || !std::isfinite(max_gate_m)) {
+    return "max_gate_m must be 0 (no cap) or at least min_gate_m";
+  }
   if (!(nlos_sigmas >= 0.0 && std::isfinite(nlos_sigmas))) return "gate_nlos_sigmas must be finite and >= 0 (0: off)";
   return {};
 }
 
 VioInnovationGates::VioInnovationGates(const GateOptions& options, double motion_m) {
   if (options.kind == GateKind::Paper || options.kind == GateKind::Both) {
-    max_phase_innovation_m_ = std::max(options.motion_factor * motion_m, options.min_gate_m);
+    const double paper_gate_m = options.motion_factor * motion_m;
+    const double capped_m = options.max_gate_m > 0.0 ? std::min(paper_gate_m, options.max_gate_m) : paper_gate_m;
+    max_phase_innovation_m_ = std::max(capped_m, options.min_gate_m);
   }
   if (options.kind == GateKind::ChiSquare || options.kind == GateKind::Both) {
     max_normalised_innovation_ = options.sigmas;

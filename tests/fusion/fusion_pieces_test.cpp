@@ -90,6 +90,13 @@ TEST(FusionPieces, TheGatesAreFiveTimesTheMotionAndChiSquare) {
   EXPECT_TRUE(gates.passes(Row(true, 2.5, 1.0).view(1e-5)));    // predicted worse than a third of the gate: no test
   EXPECT_TRUE(gates.passes(Row(false, 25.0, 0.01).view(1.0)));  // code is not gated by the motion
   EXPECT_DOUBLE_EQ(*VioInnovationGates(paper, 0.01).max_phase_innovation_m(), paper.min_gate_m);
+  GateOptions speed_aware = paper;
+  speed_aware.max_gate_m = 1.5;  // a vehicle's 3 m per epoch is capped; a walker's 0.2 m is the paper's 1 m
+  EXPECT_DOUBLE_EQ(*VioInnovationGates(speed_aware, 3.0).max_phase_innovation_m(), 1.5);
+  EXPECT_DOUBLE_EQ(*VioInnovationGates(speed_aware, 0.2).max_phase_innovation_m(), 1.0);
+  EXPECT_DOUBLE_EQ(*VioInnovationGates(speed_aware, 0.01).max_phase_innovation_m(), paper.min_gate_m);
+  speed_aware.max_gate_m = 0.4;
+  EXPECT_FALSE(speed_aware.validate().empty());  // a cap below the floor
   GateOptions chi;
   chi.kind = GateKind::ChiSquare;
   chi.nlos_sigmas = 0.0;
