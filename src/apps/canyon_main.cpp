@@ -279,6 +279,10 @@ int run_process_command(const ProcessArgs& args) {
       std::snprintf(buffer, sizeof buffer, ", %d fixed (%.1f %%)", summary->fixed,
                     summary->epochs > 0 ? 100.0 * summary->fixed / summary->epochs : 0.0);
       fixed = buffer;
+      if (summary->partial_fixed > 0) {
+        std::snprintf(buffer, sizeof buffer, ", %d partial fixes (float, Q 2)", summary->partial_fixed);
+        fixed += buffer;
+      }
     }
     std::fprintf(stderr, "canyon process: %d epochs, %d solved (%.1f %%)%s, %.2f s wall, solution: %s\n",
                  summary->epochs, summary->solved, percent, fixed.c_str(), summary->wall_s, config.out.c_str());

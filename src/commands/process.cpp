@@ -270,6 +270,7 @@ Status run_staged(pipeline::EpochEstimator& estimator, pipeline::ObservationStre
       if (out.solution.status == core::SolutionStatus::Fixed) {
         ++summary.fixed;
       } else {
+        if (core::exact_status(out.solution) == core::kPartialFixStatus) ++summary.partial_fixed;
         add_epoch_note(summary, t, status_word(out.solution.status), out.note);
       }
     } else {

@@ -124,7 +124,8 @@ std::string prometheus_text(const std::string& snapshot_json, std::uint64_t snap
   }
   if (j.contains("solution") && j["solution"].is_object()) {
     const Json& s = j["solution"];
-    header(out, "canyon_solution_status", "gauge", "Solution status (1 fixed, 2 float, 5 single, 7 VIO fill-in).");
+    header(out, "canyon_solution_status", "gauge",
+           "Solution status (1 fixed, 2 float, 5 single, 7 VIO fill-in, 8 partial fix).");
     sample(out, "canyon_solution_status", "", s.value("status", Json()));
     header(out, "canyon_solution_sequence", "counter", "Sequence number of the newest solution.");
     sample(out, "canyon_solution_sequence", "", s.value("seq", Json()));

@@ -82,7 +82,7 @@ msg::Solution to_msg_solution(const pipeline::SolvedEpoch& solved, const EpochCo
   if (solved.output) {
     const pipeline::EpochOutput& o = *solved.output;
     const core::Solution& s = o.solution;
-    m.status(static_cast<std::uint8_t>(s.status));
+    m.status(core::exact_status(s));
     m.p_E_m({s.p_E_m.x(), s.p_E_m.y(), s.p_E_m.z()});
     m.covariance_E_m2(upper(s.P_E_m2));
     const core::ProtectionLevels pl = core::protection_levels(s.p_E_m, s.P_E_m2);
@@ -325,15 +325,18 @@ Result<io::TimeSyncPair> from_msg(const msg::TimeSyncSample& m) {
 Result<core::Solution> from_msg(const msg::Solution& m) {
   const std::string which = "Solution " + std::to_string(m.sequence_number());
   const int status = m.status();
-  if (status != 0 && status != 1 && status != 2 && status != 5 && status != 7) {
-    return Error{which + ": status " + std::to_string(status) + " is not 0, 1, 2, 5 or 7"};
+  if (status != 0 && status != 1 && status != 2 && status != 5 && status != 7 && status != core::kPartialFixStatus) {
+    return Error{which + ": status " + std::to_string(status) + " is not 0, 1, 2, 5, 7 or 8"};
   }
   if (m.pruned().size() > kMaxSatellites || m.rejected().size() > kMaxSatellites || m.note().size() > kMaxNote) {
     return Error{which + ": a list exceeds its IDL bound"};
   }
   core::Solution s;
   s.time = core::GpsTime{m.gps_week(), m.gps_tow_s()};
-  s.status = static_cast<core::SolutionStatus>(status);
+  // A partial fix is a float conditioned on fixed combinations (how many is not on the wire: at least one).
+  s.status =
+      status == core::kPartialFixStatus ? core::SolutionStatus::Float : static_cast<core::SolutionStatus>(status);
+  s.fixed_combinations = status == core::kPartialFixStatus ? 1 : 0;
   s.p_E_m = Eigen::Vector3d(m.p_E_m()[0], m.p_E_m()[1], m.p_E_m()[2]);
   s.P_E_m2 = from_upper(m.covariance_E_m2());
   s.num_satellites = m.num_satellites();

@@ -247,6 +247,7 @@ void RtkEngine::conclude_fixes() {
       // position conditioned on them is still the better one.
       sol.p_E_m = imprecise->p_E_m;
       sol.P_E_m2 = imprecise->P_E_m2;
+      sol.fixed_combinations = static_cast<int>(imprecise->a_fix.size());
       out.note +=
           "; float position conditioned on " + std::to_string(imprecise->a_fix.size()) + " fixed integer combinations";
       hold_imprecise(*imprecise);

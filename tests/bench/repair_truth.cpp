@@ -21,7 +21,9 @@
 // one between line-of-sight signals equals the true integer, and the epoch is counted by that and by its position
 // (within 10 cm of the truth or beyond).
 // Prints, over all seeds, the table of starts, a line "repairs=N wrong=M wrong_pct=X nlos=K ...", a line
-// "fixed_epochs=N within_10cm: integers_right=A integers_wrong=B; beyond_10cm: ..." and a line
+// "fixed_epochs=N within_10cm: integers_right=A integers_wrong=B; beyond_10cm: ...", a line of the partial fixes'
+// and the other floats' 3D errors "partial_fix_epochs=N error_3d_m median=X p95=Y within_10cm=K; float_epochs=..." and
+// a line
 // "blockages=N ... time_to_correct_fix_s median=X p90=Y max=Z".
 
 #include <algorithm>
@@ -212,12 +214,14 @@ struct Blockages {
 /// Fixed epochs by their DD integers against the true ones and by their position against the truth.
 struct FixedTally {
   int epochs = 0;
-  int correct_right = 0;   // within 10 cm, every judged integer right
-  int correct_wrong = 0;   // within 10 cm, some integer wrong
-  int off_right = 0;       // beyond 10 cm, every judged integer right
-  int off_wrong = 0;       // beyond 10 cm, some integer wrong
-  int on_reflections = 0;  // some integer of a reflected signal (no true integer), none judged wrong
-  int combinations = 0;    // fixed integer combinations, not listed
+  int correct_right = 0;                // within 10 cm, every judged integer right
+  int correct_wrong = 0;                // within 10 cm, some integer wrong
+  int off_right = 0;                    // beyond 10 cm, every judged integer right
+  int off_wrong = 0;                    // beyond 10 cm, some integer wrong
+  int on_reflections = 0;               // some integer of a reflected signal (no true integer), none judged wrong
+  int combinations = 0;                 // fixed integer combinations, not listed
+  std::vector<double> partial_error_m;  // 3D error of each partial fix (a float conditioned on fixed combinations)
+  std::vector<double> float_error_m;    // 3D error of each other float
 };
 
 /// The verdict on one fixed epoch's integers: -1 some wrong, 0 some on a reflection (none wrong), 1 all right,
@@ -355,6 +359,11 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
     const bool within = is_fixed && (out->solution.p_E_m - sim->truth[k].p_E_m).norm() <= 0.10;
     clear.push_back(line_of_sight_satellites(sim->rover.truth[k]) >= canyon::sim::kLineOfSightCeilingSatellites);
     correct.push_back(within);
+    if (out && out->solution.status == canyon::core::SolutionStatus::Float) {
+      const double error_m = (out->solution.p_E_m - sim->truth[k].p_E_m).norm();
+      const bool partial = canyon::core::exact_status(out->solution) == canyon::core::kPartialFixStatus;
+      (partial ? fixed.partial_error_m : fixed.float_error_m).push_back(error_m);
+    }
     if (is_fixed) {
       tally_fixed(judge_integers(out->rtk.fixed_ambiguities, sim->rover.truth[k], sim->base.truth[base]), within,
                   fixed);
@@ -378,11 +387,21 @@ double percentile(std::vector<double> values, double q) {
   return values[i];
 }
 
+std::size_t within_10cm(const std::vector<double>& errors_m) {
+  return static_cast<std::size_t>(std::count_if(errors_m.begin(), errors_m.end(), [](double e) { return e <= 0.10; }));
+}
+
 void print_fixed(const FixedTally& t) {
   std::printf(
       "fixed_epochs=%d within_10cm: integers_right=%d integers_wrong=%d; beyond_10cm: integers_right=%d "
       "integers_wrong=%d; on_reflections=%d combinations=%d\n",
       t.epochs, t.correct_right, t.correct_wrong, t.off_right, t.off_wrong, t.on_reflections, t.combinations);
+  std::printf(
+      "partial_fix_epochs=%zu error_3d_m median=%.3f p95=%.3f within_10cm=%zu; float_epochs=%zu error_3d_m "
+      "median=%.3f p95=%.3f within_10cm=%zu\n",
+      t.partial_error_m.size(), percentile(t.partial_error_m, 0.5), percentile(t.partial_error_m, 0.95),
+      within_10cm(t.partial_error_m), t.float_error_m.size(), percentile(t.float_error_m, 0.5),
+      percentile(t.float_error_m, 0.95), within_10cm(t.float_error_m));
 }
 
 void print_blockages(const Blockages& b) {

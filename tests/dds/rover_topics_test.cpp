@@ -95,6 +95,19 @@ TEST(RoverMsgs, SolutionRoundTripsBitForBit) {
   EXPECT_GT(m.hpl_m(), 6.0 * 0.01);  // at least 6 sigma of the smallest axis (1 cm)
   EXPECT_NE(describe(m).find("HPL"), std::string::npos);
 
+  // A partial fix (a float conditioned on fixed integer combinations) goes out as canyon's own status 8.
+  pipeline::SolvedEpoch partial = solved_item(8);
+  partial.output->solution.status = core::SolutionStatus::Float;
+  partial.output->solution.fixed_combinations = 6;
+  const msg::Solution partial_msg = to_msg_solution(partial, context);
+  EXPECT_EQ(partial_msg.status(), core::kPartialFixStatus);
+  auto partial_back = from_msg(partial_msg);
+  ASSERT_TRUE(partial_back.ok()) << partial_back.error().to_string();
+  EXPECT_EQ(partial_back->status, core::SolutionStatus::Float);
+  EXPECT_EQ(core::exact_status(*partial_back), core::kPartialFixStatus);
+  partial.output->solution.fixed_combinations = 0;
+  EXPECT_EQ(to_msg_solution(partial, context).status(), 2);
+
   msg::Solution bad = m;
   bad.status(3);
   EXPECT_NE(from_msg(bad).error().message.find("status 3"), std::string::npos);

@@ -9,7 +9,7 @@ Chart.register(BarController, BarElement, LineController, LineElement, PointElem
   CategoryScale, LinearScale, Legend, Tooltip);
 
 const MAX_POINTS = 600;
-const STATUS = { 1: ['fixed', '#2e7d32'], 2: ['float', '#f9a825'], 5: ['single', '#c62828'], 7: ['VIO fill-in', '#6a1b9a'] };
+const STATUS = { 1: ['fixed', '#2e7d32'], 2: ['float', '#f9a825'], 5: ['single', '#c62828'], 7: ['VIO fill-in', '#6a1b9a'], 8: ['partial fix', '#ef6c00'] };
 const PALETTE = ['#1565c0', '#00897b', '#8e24aa', '#ef6c00', '#5d4037', '#3949ab', '#c0ca33', '#d81b60'];
 const statusName = (s) => (STATUS[s] ? STATUS[s][0] : (s === undefined ? '-' : `status ${s}`));
 const statusColor = (s) => (STATUS[s] ? STATUS[s][1] : '#757575');

@@ -20,6 +20,7 @@ struct ProcessSummary {
   int epochs = 0;                     ///< rover epochs read
   int solved = 0;                     ///< epochs with a solution written
   int fixed = 0;                      ///< epochs with a fixed (RTK) solution
+  int partial_fixed = 0;              ///< float epochs conditioned on fixed integer combinations (partial fixes)
   double wall_s = 0.0;                ///< wall-clock time of the whole run
   std::vector<std::string> warnings;  ///< recovered input defects, "file:line: what"
   /// Satellites left out by `exclude_most_observed`, most observed first.
