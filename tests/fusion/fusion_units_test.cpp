@@ -22,6 +22,7 @@
 #include "canyon/config/scenario_config.hpp"
 #include "canyon/core/constants.hpp"
 #include "canyon/core/geodesy.hpp"
+#include "canyon/core/statistics.hpp"
 #include "canyon/fusion/alignment.hpp"
 #include "canyon/fusion/cn0_screen.hpp"
 #include "canyon/fusion/fusion_engine.hpp"
@@ -1025,13 +1026,6 @@ TEST(FusionHeadingTest, TheHeadingStateCorrectsTheCoarseAlignmentsYawInAStreetCa
   EXPECT_EQ(with.stats.integrity_restarts, 0) << "a run that follows the single points is never restarted";
 }
 
-double median(std::vector<double> values) {
-  if (values.empty()) return std::nan("");
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
-
 TEST(FusionPartialFixTest, APartialFixIsItsOwnStatusAndCloserThanAFloat) {
   // downtown, seed 4, 300 s: where too few combinations fix to pin the position, the float conditioned on the fixed
   // (wide-lane-like) ones is reported as a partial fix (status 8 beside Q 2). Measured: 351 partial fixes, median 3D
@@ -1039,8 +1033,12 @@ TEST(FusionPartialFixTest, APartialFixIsItsOwnStatusAndCloserThanAFloat) {
   auto simulated = simulate_scenario("downtown", 300.0, "partial-fix", {}, 4);
   ASSERT_TRUE(simulated);
   const FusionRun run = run_fusion(simulated->sim, simulated->scenario.start, [](config::ProcessConfig&) {});
-  const double partial_m = median(run.partial_fix_errors_m);
-  const double float_m = median(run.float_errors_m);
+  ASSERT_FALSE(run.partial_fix_errors_m.empty());
+  ASSERT_FALSE(run.float_errors_m.empty());
+  std::vector<double> partial_errors_m = run.partial_fix_errors_m;
+  std::vector<double> float_errors_m = run.float_errors_m;
+  const double partial_m = core::median_in_place(partial_errors_m);
+  const double float_m = core::median_in_place(float_errors_m);
   std::printf("downtown seed 4, 300 s: %zu partial fixes (median 3D error %.3f m), %zu other floats (%.3f m)\n",
               run.partial_fix_errors_m.size(), partial_m, run.float_errors_m.size(), float_m);
   EXPECT_GT(run.partial_fix_errors_m.size(), 100U);
