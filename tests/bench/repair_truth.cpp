@@ -3,6 +3,7 @@
 // the time to a correct fix after each blockage.
 //
 //   bench_repair_truth SCENARIO.yaml SEED... [--mode fusion|rtk] [--config FILE] [--max-sigma CYC] [--duration S]
+//                      [--align-at S]
 //
 // Each seed of the scenario is simulated in memory with its signal truth, and fused with FILE (default
 // config/fusion.yaml; with --mode rtk canyon rtk without the VIO, default config/rtk.yaml) with
@@ -25,6 +26,11 @@
 // and the other floats' 3D errors "partial_fix_epochs=N error_3d_m median=X p95=Y within_10cm=K; float_epochs=..." and
 // a line
 // "blockages=N ... time_to_correct_fix_s median=X p90=Y max=Z".
+// In fusion, per seed and over the seeds, the alignment at --align-at S (default 180 s after the start): the heading
+// error of the aligned VIO attitude R_EO R_OI against the true R_EI (about the local vertical, deg) and the
+// horizontal error of the lever arm t_IA in use against the scenario's (m, in the local level frame through the true
+// attitude); "none" when no alignment holds then. Lines "alignment seed=N ..." and "alignment_at_s=S seeds=N
+// aligned=K heading_error_deg median=X max=Y lever_arm_horizontal_error_m max=Z fine=F".
 
 #include <algorithm>
 #include <cmath>
@@ -43,6 +49,7 @@
 
 #include "canyon/config/process_config.hpp"
 #include "canyon/config/scenario_config.hpp"
+#include "canyon/core/geodesy.hpp"
 #include "canyon/fusion/fusion_engine.hpp"
 #include "canyon/fusion/vio_track.hpp"
 #include "canyon/gnss/ephemeris.hpp"
@@ -64,8 +71,9 @@ struct Args {
   std::vector<std::uint64_t> seeds;
   std::string config;  // default: config/fusion.yaml, or config/rtk.yaml with --mode rtk
   double max_sigma_cyc = 0.15;
-  double duration_s = 0.0;  // 0: the scenario's
-  bool rtk = false;         // canyon rtk (no VIO) instead of fusion
+  double duration_s = 0.0;    // 0: the scenario's
+  bool rtk = false;           // canyon rtk (no VIO) instead of fusion
+  double align_at_s = 180.0;  // when the alignment is judged, after the start
 };
 
 std::optional<Args> parse_args(int argc, char** argv) {
@@ -81,6 +89,8 @@ std::optional<Args> parse_args(int argc, char** argv) {
       const std::string mode = argv[++i];
       if (mode != "rtk" && mode != "fusion") return std::nullopt;
       args.rtk = mode == "rtk";
+    } else if (a == "--align-at" && has_value) {
+      args.align_at_s = std::atof(argv[++i]);
     } else if (a == "--duration" && has_value) {
       args.duration_s = std::atof(argv[++i]);
     } else if (args.scenario.empty()) {
@@ -294,13 +304,45 @@ void tally_blockages(const std::vector<bool>& clear, const std::vector<bool>& co
   }
 }
 
+/// The alignment judged at one epoch against the truth (fusion).
+struct AlignmentCheck {
+  bool aligned = false;
+  bool fine = false;
+  double heading_error_deg = 0.0;
+  double lever_arm_horizontal_error_m = 0.0;
+};
+
+/// The aligned VIO attitude R_EO R_OI of the VIO sample nearest `t` against the true attitude `truth`, and the lever
+/// arm in use against the scenario's `t_IA_true_m`.
+AlignmentCheck check_alignment(const canyon::fusion::FusionEngine& fusion,
+                               const std::vector<canyon::sim::VioSample>& vio, const canyon::sim::TruthSample& truth,
+                               const Eigen::Vector3d& t_IA_true_m) {
+  AlignmentCheck check;
+  const std::optional<canyon::fusion::VioAlignment>& alignment = fusion.alignment();
+  const auto nearest = std::min_element(vio.begin(), vio.end(), [&](const auto& a, const auto& b) {
+    return std::abs(a.time - truth.time) < std::abs(b.time - truth.time);
+  });
+  if (!alignment || nearest == vio.end()) return check;
+  check.aligned = true;
+  check.fine = alignment->fine;
+  const Eigen::Matrix3d R_NE = canyon::core::rotation_enu_from_ecef(canyon::core::ecef_to_geodetic(truth.p_E_m));
+  const Eigen::Matrix3d R_EI_true = truth.q_EI.toRotationMatrix();
+  const Eigen::Matrix3d R_EI = alignment->T_EO.rotation() * nearest->T_OI.rotation();
+  const Eigen::Matrix3d dR_N = R_NE * R_EI * R_EI_true.transpose() * R_NE.transpose();
+  check.heading_error_deg = std::abs(std::atan2(dR_N(1, 0), dR_N(0, 0))) * 180.0 / M_PI;
+  const Eigen::Vector3d d_N = R_NE * R_EI_true * (fusion.lever_arm_m() - t_IA_true_m);
+  check.lever_arm_horizontal_error_m = d_N.head<2>().norm();
+  return check;
+}
+
 /// One epoch's solution and the RTK filter's epoch under it.
 struct Step {
   canyon::core::Solution solution;
   canyon::rtk::RtkEpoch rtk;
 };
 
-bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blockages& blockages, FixedTally& fixed) {
+bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blockages& blockages, FixedTally& fixed,
+              std::optional<AlignmentCheck>& alignment) {
   auto scenario = canyon::config::load_scenario(args.scenario);
   if (!scenario) {
     std::fprintf(stderr, "bench_repair_truth: %s\n", scenario.error().to_string().c_str());
@@ -375,6 +417,9 @@ bool run_seed(const Args& args, std::uint64_t seed, Tally (&tallies)[kBins], Blo
       }
     }
     note_phases(e, last);
+    if (fusion && !alignment && e.time - start >= args.align_at_s) {
+      alignment = check_alignment(*fusion, sim->vio.poses, sim->truth[k], scenario->vio.t_IA_m);
+    }
   }
   tally_blockages(clear, correct, epoch_s, blockages);
   return true;
@@ -434,15 +479,48 @@ void print_table(const Tally (&tallies)[kBins]) {
               all.max_error_cyc);
 }
 
+void print_alignment(std::uint64_t seed, const AlignmentCheck& a) {
+  if (!a.aligned) {
+    std::printf("alignment seed=%llu none\n", static_cast<unsigned long long>(seed));
+    return;
+  }
+  std::printf("alignment seed=%llu %s heading_error_deg=%.3f lever_arm_horizontal_error_m=%.4f\n",
+              static_cast<unsigned long long>(seed), a.fine ? "fine" : "coarse", a.heading_error_deg,
+              a.lever_arm_horizontal_error_m);
+}
+
+/// Over the seeds: how many were aligned at `at_s`, their heading errors and the worst lever-arm error.
+void print_alignments(double at_s, std::size_t seeds, const std::vector<AlignmentCheck>& checks) {
+  std::vector<double> heading_deg;
+  double lever_max_m = 0.0;
+  int fine = 0;
+  for (const AlignmentCheck& a : checks) {
+    if (!a.aligned) continue;
+    heading_deg.push_back(a.heading_error_deg);
+    lever_max_m = std::max(lever_max_m, a.lever_arm_horizontal_error_m);
+    fine += a.fine ? 1 : 0;
+  }
+  std::printf(
+      "alignment_at_s=%.0f seeds=%zu aligned=%zu heading_error_deg median=%.3f max=%.3f "
+      "lever_arm_horizontal_error_m max=%.4f fine=%d\n",
+      at_s, seeds, heading_deg.size(), percentile(heading_deg, 0.5), percentile(heading_deg, 1.0), lever_max_m, fine);
+}
+
 /// Runs every seed and prints the tables; false on an error (printed).
 bool run(const Args& args) {
   Tally tallies[kBins];
   Blockages blockages;
   FixedTally fixed;
+  std::vector<AlignmentCheck> alignments;
   for (const std::uint64_t seed : args.seeds) {
     Tally seed_tallies[kBins];
     std::printf("seed %llu\n", static_cast<unsigned long long>(seed));
-    if (!run_seed(args, seed, seed_tallies, blockages, fixed)) return false;
+    std::optional<AlignmentCheck> alignment;
+    if (!run_seed(args, seed, seed_tallies, blockages, fixed, alignment)) return false;
+    if (alignment) {
+      alignments.push_back(*alignment);
+      print_alignment(seed, *alignment);
+    }
     int starts = 0, wrong = 0;
     for (int b = 0; b < kBins; ++b) {
       starts += seed_tallies[b].starts;
@@ -461,6 +539,7 @@ bool run(const Args& args) {
   print_table(tallies);
   print_fixed(fixed);
   print_blockages(blockages);
+  if (!args.rtk) print_alignments(args.align_at_s, args.seeds.size(), alignments);
   return true;
 }
 
@@ -472,7 +551,7 @@ int main(int argc, char** argv) {
     std::fprintf(
         stderr,
         "usage: bench_repair_truth SCENARIO.yaml SEED... [--mode fusion|rtk] [--config FILE] [--max-sigma CYC] "
-        "[--duration S]\n");
+        "[--duration S] [--align-at S]\n");
     return 2;
   }
   try {

@@ -71,6 +71,7 @@ class AlignmentSchedule {
   /// The alignment that holds for `pose`'s segment (nullptr if none).
   [[nodiscard]] VioAlignment* alignment_for(const std::optional<VioPoseAt>& pose);
   [[nodiscard]] std::optional<VioAlignment>& alignment() { return alignment_; }
+  [[nodiscard]] const std::optional<VioAlignment>& alignment() const { return alignment_; }
   /// The lever arm t_IA in use (the prior until calibrated) (m, IMU frame).
   [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return t_IA_m_; }
 

@@ -136,6 +136,8 @@ class FusionEngine {
   }
   /// The lever arm t_IA in use (the prior until calibrated) (m, IMU frame).
   [[nodiscard]] const Eigen::Vector3d& lever_arm_m() const { return schedule_.lever_arm_m(); }
+  /// The alignment T_EO in use, with the filter's heading corrections folded in (nullopt before the first one).
+  [[nodiscard]] const std::optional<VioAlignment>& alignment() const { return schedule_.alignment(); }
 
   [[nodiscard]] const FusionStats& stats() const { return stats_; }
   /// Human-readable summary: alignments, calibration and lever-arm observability, validation and guard counts
