@@ -16,6 +16,8 @@ packages=(
   # deployment (issue 8): link emulator, namespaces, DDS-Security test PKI, dashboard server and its browser test
   libnetfilter-queue-dev iptables iproute2 iputils-ping openssl python3
   libcpp-httplib-dev nlohmann-json3-dev chromium python3-websocket nodejs
+  # map tracks (issue 29): independent GPX and KML readers for the tracks' test
+  python3-gpxpy python3-fastkml
 )
 
 # One dpkg-query call for all packages; a package dpkg has never heard of prints nothing and counts as missing.

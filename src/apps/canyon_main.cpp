@@ -475,6 +475,10 @@ void add_evaluate_command(CLI::App& app, EvaluateArgs& args) {
   cmd->add_option("--json", c.json, "JSON file (instead of DIR/evaluation.json)");
   cmd->add_option("--trajectory-svg", c.trajectory_svg, "Trajectory plot (instead of DIR/trajectory.svg)");
   cmd->add_option("--ape-svg", c.ape_svg, "Error-over-time plot (instead of DIR/ape.svg)");
+  cmd->add_option("--kml", c.kml,
+                  "KML 2.2 file for Google Earth: every solution's epochs coloured by status (fixed green, float "
+                  "yellow, single red, VIO fill-in blue) and the truth as a white line");
+  cmd->add_option("--gpx", c.gpx, "GPX 1.1 file: a track per solution and status, the truth as a track");
   cmd->add_option("--wrong-fix-m", c.wrong_fix_threshold_m,
                   "Fixed epochs with a larger 3D error are wrong fixes (m), default 0.10")
       ->check(CLI::PositiveNumber);
@@ -572,14 +576,20 @@ struct ConvertArgs {
 
 void add_convert_command(CLI::App& app, ConvertArgs& args) {
   CLI::App* cmd = app.add_subcommand(
-      "convert", "RTCM 3 or u-blox UBX (file or stdin) -> RINEX 3 observations and navigation; RINEX -> RTCM 3");
+      "convert",
+      "RTCM 3 or u-blox UBX (file or stdin) -> RINEX 3 observations and navigation; RINEX -> RTCM 3; solutions "
+      "(.pos) -> KML, GPX");
   canyon::commands::ConvertConfig& c = args.config;
   cmd->add_option("input", c.input,
                   "Input: RTCM 3 / UBX stream file (may be .gz; '-' reads stdin; tcp://HOST:PORT or "
                   "ntrip://[USER[:PASS]@]HOST:PORT/MOUNT records a live stream) or RINEX observations")
       ->required();
-  cmd->add_option("--from", c.from, "Input format: auto (default), rtcm3, ubx or rinex")
-      ->check(CLI::IsMember({"auto", "rtcm3", "ubx", "rinex"}));
+  cmd->add_option("--from", c.from, "Input format: auto (default), rtcm3, ubx, rinex or pos (a solution file)")
+      ->check(CLI::IsMember({"auto", "rtcm3", "ubx", "rinex", "pos"}));
+  cmd->add_option("--kml", c.kml,
+                  "Solution input: KML 2.2 track for Google Earth, epochs coloured by status (fixed green, float "
+                  "yellow, single red, VIO fill-in blue; default with --from pos: INPUT.kml)");
+  cmd->add_option("--gpx", c.gpx, "Solution input: GPX 1.1 file, a track per status");
   cmd->add_option("--obs-out", c.obs_out, "RINEX observation output (default: INPUT.obs)");
   cmd->add_option("--nav-out", c.nav_out, "RINEX navigation output (default: INPUT.nav)");
   cmd->add_option("--time", args.time,

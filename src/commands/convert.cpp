@@ -12,7 +12,9 @@
 #include <mutex>
 #include <thread>
 
+#include "canyon/eval/map_tracks.hpp"
 #include "canyon/io/gnss_stream.hpp"
+#include "canyon/io/pos_file.hpp"
 #include "canyon/io/rinex_nav.hpp"
 #include "canyon/io/rinex_obs.hpp"
 #include "canyon/io/rtcm3_station_stream.hpp"
@@ -304,12 +306,45 @@ Result<ConvertSummary> rinex_to_rtcm(const ConvertConfig& config, std::vector<st
   return summary;
 }
 
+/// A solution file's epochs as map tracks (KML, GPX).
+Result<ConvertSummary> pos_to_tracks(const ConvertConfig& config) {
+  auto solutions = io::read_pos_file(config.input);
+  if (!solutions) return solutions.error();
+  eval::MapTracks tracks;
+  tracks.tracks.push_back({std::filesystem::path(config.input).stem().string(), std::move(*solutions)});
+  ConvertSummary summary;
+  summary.epochs = static_cast<int>(tracks.tracks.front().solutions.size());
+  std::string kml = config.kml;
+  if (kml.empty() && config.gpx.empty()) kml = std::filesystem::path(config.input).replace_extension(".kml").string();
+  if (!kml.empty()) {
+    if (Status s = eval::write_kml(kml, tracks); !s) return s.error();
+    summary.written.push_back(kml);
+  }
+  if (!config.gpx.empty()) {
+    if (Status s = eval::write_gpx(config.gpx, tracks); !s) {
+      Error e = s.error();
+      if (!kml.empty()) e.message += " (written before it and kept: " + kml + ")";
+      return e;
+    }
+    summary.written.push_back(config.gpx);
+  }
+  summary.direction = kml.empty() ? "pos -> gpx" : (config.gpx.empty() ? "pos -> kml" : "pos -> kml, gpx");
+  summary.statistics = std::to_string(summary.epochs) + " solutions";
+  return summary;
+}
+
 }  // namespace
 
 std::string ConvertConfig::validate() const {
   if (input.empty()) return "an input file is required";
-  if (from != "auto" && from != "rtcm3" && from != "ubx" && from != "rinex") {
-    return "--from must be auto, rtcm3, ubx or rinex, not '" + from + "'";
+  if (from != "auto" && from != "rtcm3" && from != "ubx" && from != "rinex" && from != "pos") {
+    return "--from must be auto, rtcm3, ubx, rinex or pos, not '" + from + "'";
+  }
+  if ((!kml.empty() || !gpx.empty()) && from != "auto" && from != "pos") {
+    return "--kml and --gpx take a solution file (.pos), not --from " + from;
+  }
+  if ((from == "pos" || !kml.empty() || !gpx.empty()) && (input == "-" || input.find("://") != std::string::npos)) {
+    return "a solution input (.pos) must be a file";
   }
   if (from == "rinex" && (input == "-" || input.find("://") != std::string::npos)) return "RINEX input must be a file";
   if (!(duration_s >= 0.0)) return "duration must be >= 0 s";
@@ -325,6 +360,7 @@ std::string ConvertConfig::validate() const {
 Result<ConvertSummary> run_convert(const ConvertConfig& config) {
   if (const std::string e = config.validate(); !e.empty()) return Error{e};
   std::vector<std::string> warnings;
+  if (config.from == "pos" || !config.kml.empty() || !config.gpx.empty()) return pos_to_tracks(config);
   if (config.from == "rinex") return rinex_to_rtcm(config, warnings);
   auto bytes = read_input(config, warnings);
   if (!bytes) return bytes.error();

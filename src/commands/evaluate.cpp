@@ -7,6 +7,7 @@
 #include <set>
 
 #include "canyon/eval/city_map.hpp"
+#include "canyon/eval/map_tracks.hpp"
 #include "canyon/eval/plots.hpp"
 #include "canyon/eval/report.hpp"
 #include "canyon/io/pos_file.hpp"
@@ -49,7 +50,8 @@ struct OutputPaths {
 
 OutputPaths output_paths(const EvaluateConfig& c) {
   OutputPaths out{c.markdown, c.json, c.trajectory_svg, c.ape_svg};
-  const bool any_file = !(c.markdown.empty() && c.json.empty() && c.trajectory_svg.empty() && c.ape_svg.empty());
+  const bool any_file = !(c.markdown.empty() && c.json.empty() && c.trajectory_svg.empty() && c.ape_svg.empty() &&
+                          c.kml.empty() && c.gpx.empty());
   std::string dir = c.out_dir;
   if (dir.empty() && !any_file) dir = (fs::path(c.solutions.front()).parent_path() / "evaluation").string();
   if (dir.empty()) return out;
@@ -66,6 +68,29 @@ Status write_text(const std::string& path, const std::string& text, const std::s
   if (!file) return file.error();
   if (Status s = file->write_line(text, ""); !s) return s;
   return file->close();
+}
+
+/// The KML and GPX tracks of the evaluated solutions with the truth; an error lists what was written before it.
+Status write_map_tracks(const EvaluateConfig& config, const eval::EvaluationReport& report, const eval::Truth& truth,
+                        std::vector<std::string>& written) {
+  if (config.kml.empty() && config.gpx.empty()) return Ok{};
+  eval::MapTracks tracks;
+  for (const eval::SolutionReport& s : report.solutions) tracks.tracks.push_back({s.label, s.solutions});
+  tracks.truth = truth.samples();
+  const auto attempt = [&](const std::string& path, Status (*writer)(const std::string&, const eval::MapTracks&)) {
+    if (path.empty()) return Status{Ok{}};
+    if (Status s = writer(path, tracks); !s) {
+      std::string kept;
+      for (const std::string& w : written) kept += (kept.empty() ? "" : ", ") + w;
+      Error e = s.error();
+      e.message += kept.empty() ? " (nothing else was written)" : " (written before it and kept: " + kept + ")";
+      return Status{e};
+    }
+    written.push_back(path);
+    return Status{Ok{}};
+  };
+  if (Status s = attempt(config.kml, eval::write_kml); !s) return s;
+  return attempt(config.gpx, eval::write_gpx);
 }
 
 }  // namespace
@@ -154,6 +179,7 @@ Result<EvaluateSummary> run_evaluate(const EvaluateConfig& config) {
       !s) {
     return s.error();
   }
+  if (Status s = write_map_tracks(config, *report, *truth, summary.written); !s) return s.error();
   return summary;
 }
 

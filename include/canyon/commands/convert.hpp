@@ -30,7 +30,7 @@ struct ConvertConfig {
   /// Input: a file, "-" (standard input), "tcp://HOST:PORT" or "ntrip://[USER[:PASSWORD]@]HOST:PORT/MOUNT" (a
   /// live stream, recorded until `duration_s` has passed or no byte came for `idle_timeout_s`).
   std::string input;
-  std::string from = "auto";  ///< auto | rtcm3 | ubx | rinex
+  std::string from = "auto";  ///< auto | rtcm3 | ubx | rinex | pos (a solution file; implied by kml or gpx)
   // Binary -> RINEX.
   std::string obs_out;                       ///< RINEX observations (default: the input name with .obs)
   std::string nav_out;                       ///< RINEX navigation (default: the input name with .nav)
@@ -47,13 +47,16 @@ struct ConvertConfig {
   double station_interval_s = 10.0;             ///< 1005 every this many seconds (0: once)
   double ephemeris_interval_s = 0.0;            ///< repeat current ephemerides (0: each once, when it becomes current)
   std::optional<Eigen::Vector3d> position_E_m;  ///< 1005 antenna reference point (default: header position)
+  // Solutions (.pos) -> map tracks (eval/map_tracks.hpp).
+  std::string kml;  ///< KML 2.2 track by status (with --from pos and neither given: the input name with .kml)
+  std::string gpx;  ///< GPX 1.1 tracks by status
 
   /// Empty if valid, else the violated rule.
   [[nodiscard]] std::string validate() const;
 };
 
 struct ConvertSummary {
-  std::string direction;  ///< "rtcm3 -> rinex", "ubx -> rinex", "rinex -> rtcm3"
+  std::string direction;  ///< "rtcm3 -> rinex", "ubx -> rinex", "rinex -> rtcm3", "pos -> kml, gpx"
   int epochs = 0;
   int ephemerides = 0;
   int messages = 0;                   ///< RTCM 3 frames written (rinex -> rtcm3)

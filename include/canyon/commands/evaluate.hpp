@@ -31,6 +31,8 @@ struct EvaluateConfig {
   std::string json;
   std::string trajectory_svg;
   std::string ape_svg;
+  std::string kml;  ///< KML 2.2 track of every solution by status, the truth beside them (eval/map_tracks.hpp)
+  std::string gpx;  ///< GPX 1.1 tracks, the same
   double wrong_fix_threshold_m = 0.10;  ///< fixed epochs with a larger 3D error are wrong fixes (m)
   double time_tolerance_s = 0.005;      ///< epochs closer than this are one (s)
 
@@ -45,7 +47,8 @@ struct EvaluateSummary {
 };
 
 /// Reads every input, scores the solutions and writes the outputs. Errors (bad input) name the file, and the line
-/// where there is one.
+/// where there is one. The map tracks are written last: when one cannot be written the error says so and lists the
+/// files already written (they stay).
 Result<EvaluateSummary> run_evaluate(const EvaluateConfig& config);
 
 /// Labels for `config`: the given ones, or each solution's file name without its extension (the whole path where
