@@ -73,7 +73,8 @@ int run(int argc, char** argv) {
   cli.add_option("--pipeline", o.pipeline_mode, "Override pipeline.threaded: threaded or sequential")
       ->check(CLI::IsMember({"threaded", "sequential"}));
   cli.add_option("--wait-for-subscribers", options.wait_subscribers,
-                 "Start once this many readers of the solution topic are matched (so they miss nothing)")
+                 "Start once this many readers of the solution topic (and, with ros2.enabled, of the ROS 2 topics, "
+                 "counted together) are matched (so they miss nothing)")
       ->check(CLI::NonNegativeNumber);
   cli.add_option("--wait-timeout", options.wait_timeout_s, "Give up waiting for subscribers after this many seconds");
   cli.add_flag("-q,--quiet", quiet, "Warnings and errors only");

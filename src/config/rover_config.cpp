@@ -152,6 +152,24 @@ const Table<R>& dds_table() {
   return table;
 }
 
+const Table<Ros2Options>& ros2_table() {
+  using O = Ros2Options;
+  static const Table<O> table{
+      {"enabled", "", "publish the ROS 2 topics below (ROS 2 names and types, docs/usage.md#ros-2)", at(&O::enabled)},
+      {"fix_topic", "", "sensor_msgs/msg/NavSatFix out (DDS topic rt/ + this), sensor-data QoS", at(&O::fix_topic)},
+      {"odometry_topic", "", "nav_msgs/msg/Odometry out in the local ENU frame, sensor-data QoS",
+       at(&O::odometry_topic)},
+      {"diagnostics_topic", "", "diagnostic_msgs/msg/DiagnosticArray out: stage timing, canyon's exact status",
+       at(&O::diagnostics_topic)},
+      {"fix_frame_id", "", "NavSatFix header.frame_id (the antenna)", at(&O::fix_frame_id)},
+      {"map_frame_id", "", "Odometry header.frame_id (the local ENU frame)", at(&O::map_frame_id)},
+      {"antenna_frame_id", "", "Odometry child_frame_id", at(&O::antenna_frame_id)},
+      {"enu_origin_llh", "", "ENU origin [lat_deg, lon_deg, h_m] (ellipsoidal height); []: the first GNSS fix",
+       at(&O::enu_origin_llh)},
+  };
+  return table;
+}
+
 /// estimator: the keys of canyon process, read by parse_process_config() (its errors name the keys without the
 /// `estimator.` prefix, as before the tables).
 Entry<R> estimator_entry() {
@@ -177,6 +195,7 @@ const Table<RoverConfig>& rover_table() {
       {"input", "the rover's observations, the base's corrections and the VIO", whole, input_table()},
       {"pipeline", "the six stages' threads and queues", at(&R::pipeline), pipeline_table()},
       {"dds", "DDS domain, QoS profiles and topics", whole, dds_table()},
+      {"ros2", "ROS 2-compatible topics (off by default)", at(&R::ros2), ros2_table()},
   };
   return table;
 }
@@ -232,6 +251,14 @@ std::string RoverConfig::validate() const {
   if (rtcm_topic.empty() || solution_topic.empty() || timing_topic.empty() || vio_topic.empty() ||
       timesync_topic.empty()) {
     return "dds topics must not be empty";
+  }
+  if (ros2.fix_topic.empty() || ros2.odometry_topic.empty() || ros2.diagnostics_topic.empty()) {
+    return "ros2 topics must not be empty";
+  }
+  if (!ros2.enu_origin_llh.empty() &&
+      (ros2.enu_origin_llh.size() != 3 || !(std::abs(ros2.enu_origin_llh[0]) <= 90.0) ||
+       !(std::abs(ros2.enu_origin_llh[1]) <= 180.0) || !(std::abs(ros2.enu_origin_llh[2]) < 1e5))) {
+    return "ros2.enu_origin_llh must be [] or [lat_deg, lon_deg, h_m] with |lat| <= 90, |lon| <= 180, |h| < 100 km";
   }
   return {};
 }

@@ -59,6 +59,10 @@ const std::vector<RequestedProfile>& requested_profiles() {
       {K::DataReader, profile::kTimingReader, "canyon record, echo, monitor (canyon/timing)"},
       {K::DataWriter, profile::kStageWriter, "canyon rover dds.publish_stages (bridged, alignment, prior, float)"},
       {K::DataReader, profile::kStageReader, "canyon record, echo (bridged, alignment, prior, float)"},
+      {K::DataWriter, profile::kRos2SensorDataWriter, "canyon rover ros2 (NavSatFix, Odometry)"},
+      {K::DataReader, profile::kRos2SensorDataReader, "canyon-ros2-raw (tests: ROS 2 samples as bytes)"},
+      {K::DataWriter, profile::kRos2DefaultWriter, "canyon rover ros2 (DiagnosticArray)"},
+      {K::DataReader, profile::kRos2DefaultReader, "canyon-ros2-raw (tests: ROS 2 samples as bytes)"},
   };
   return requested;
 }

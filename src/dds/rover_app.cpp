@@ -236,7 +236,8 @@ void RoverApp::build_pipeline(pipeline::RoverInput rover, pipeline::BaseInput ba
 void RoverApp::wait_for_subscribers() const {
   const int wanted = options_.wait_subscribers;
   if (wanted <= 0) return;
-  spdlog::info("waiting for {} solution subscriber(s) (at most {} s)", wanted, options_.wait_timeout_s);
+  spdlog::info("waiting for {} solution subscriber(s), ROS 2 topics included (at most {} s)", wanted,
+               options_.wait_timeout_s);
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(options_.wait_timeout_s);
   while (outputs_->solution_readers() < wanted && std::chrono::steady_clock::now() < until && !stop_.load()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

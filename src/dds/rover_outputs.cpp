@@ -3,6 +3,7 @@
 #include "canyon/dds/rover_outputs.hpp"
 
 #include <limits>
+#include <numbers>
 #include <string>
 #include <utility>
 
@@ -27,9 +28,22 @@ void write_pending(Writer& writer, std::optional<Msg>& pending, std::atomic<std:
 }  // namespace
 
 RoverOutputs::RoverOutputs(DdsParticipant& participant, const config::RoverConfig& config)
-    : rover_id_(config.rover_id) {
+    : rover_id_(config.rover_id), ros2_(config.ros2), leaps_(core::builtin_leap_seconds()) {
   solution_ = create_writer<SolutionWriter>(participant, config.solution_topic, profile::kSolutionWriter);
   timing_ = create_writer<TimingWriter>(participant, config.timing_topic, profile::kTimingWriter);
+  if (ros2_.enabled) {
+    ros2_fix_ =
+        create_writer<NavSatFixWriter>(participant, ros2_dds_topic(ros2_.fix_topic), profile::kRos2SensorDataWriter);
+    ros2_odometry_ = create_writer<OdometryWriter>(participant, ros2_dds_topic(ros2_.odometry_topic),
+                                                   profile::kRos2SensorDataWriter);
+    ros2_diagnostics_ = create_writer<DiagnosticsWriter>(participant, ros2_dds_topic(ros2_.diagnostics_topic),
+                                                         profile::kRos2DefaultWriter);
+    if (ros2_.enu_origin_llh.size() == 3) {
+      constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+      enu_origin_ = core::Geodetic{ros2_.enu_origin_llh[0] * kRadPerDeg, ros2_.enu_origin_llh[1] * kRadPerDeg,
+                                   ros2_.enu_origin_llh[2]};
+    }
+  }
   if (!config.publish_stages) return;
   prior_ = create_writer<PriorWriter>(participant, "canyon/prior", profile::kStageWriter);
   float_ = create_writer<FloatWriter>(participant, "canyon/float", profile::kStageWriter);
@@ -102,6 +116,17 @@ void RoverOutputs::take_solved(const pipeline::SolvedEpoch& item) {
   }
   if (bridged_) bridged_pending_ = to_msg_bridged(item);
   if (alignment_) alignment_pending_ = to_msg_alignment(item);
+  if (ros2_fix_) take_solved_ros2(item);
+}
+
+void RoverOutputs::take_solved_ros2(const pipeline::SolvedEpoch& item) {
+  const core::Solution* solution = item.output ? &item.output->solution : nullptr;
+  auto fix = to_navsatfix(item.epoch().rover.time, solution, navsat_service(item.epoch().rover), ros2_, leaps_);
+  if (!ros2_fix_->write(fix)) refused_.fetch_add(1);
+  const bool gnss = fix.status().status() >= sensor_msgs::msg::NavSatStatus_Constants::STATUS_FIX;
+  if (!enu_origin_ && gnss) enu_origin_ = core::ecef_to_geodetic(solution->p_E_m);
+  if (solution != nullptr && enu_origin_) odometry_pending_ = to_odometry(*solution, *enu_origin_, ros2_, leaps_);
+  diagnostics_pending_ = to_diagnostics(*timing_pending_, solution, leaps_);
 }
 
 void RoverOutputs::handed_on(pipeline::Stage stage) {
@@ -111,6 +136,8 @@ void RoverOutputs::handed_on(pipeline::Stage stage) {
   write_pending(prior_, prior_pending_, refused_);
   write_pending(float_, float_pending_, refused_);
   write_pending(alignment_, alignment_pending_, refused_);
+  write_pending(ros2_odometry_, odometry_pending_, refused_);
+  write_pending(ros2_diagnostics_, diagnostics_pending_, refused_);
 }
 
 Status RoverOutputs::close_pos() {

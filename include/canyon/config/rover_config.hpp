@@ -18,6 +18,20 @@ enum class RoverInputKind { Rinex, Ubx };
 enum class RoverBaseSource { File, Dds, Ntrip, Tcp };
 [[nodiscard]] const char* rover_base_source_name(RoverBaseSource source);
 
+/// ROS 2-compatible outputs (dds/ros2_outputs.hpp): the solution as sensor_msgs/msg/NavSatFix and nav_msgs/msg/Odometry
+/// (local ENU), the stage timing and canyon's exact status as diagnostic_msgs/msg/DiagnosticArray, on ROS 2's topic
+/// names ("rt/" + topic) and type names. Off by default.
+struct Ros2Options {
+  bool enabled = false;
+  std::string fix_topic = "canyon/fix";            ///< NavSatFix (DDS topic rt/canyon/fix), sensor-data QoS
+  std::string odometry_topic = "canyon/odometry";  ///< Odometry in the local ENU frame, sensor-data QoS
+  std::string diagnostics_topic = "diagnostics";   ///< DiagnosticArray (ROS 2's /diagnostics), default QoS
+  std::string fix_frame_id = "gnss";               ///< NavSatFix header.frame_id: the antenna
+  std::string map_frame_id = "map";                ///< Odometry header.frame_id: the local ENU frame
+  std::string antenna_frame_id = "gnss_antenna";   ///< Odometry child_frame_id
+  std::vector<double> enu_origin_llh;              ///< [lat_deg, lon_deg, h_m] of the ENU origin; empty: first fix
+};
+
 struct RoverConfig {
   /// The estimator and its inputs: the keys of `canyon process` (mode rtk or fusion, rover, base, nav, vio,
   /// timesync, base_position, rtk, fusion, output; `out`: a .pos the rover writes itself, optional).
@@ -45,6 +59,7 @@ struct RoverConfig {
   std::string vio_topic = "canyon/vio";            ///< canyon::msg::VioPose in (input.vio dds)
   std::string timesync_topic = "canyon/timesync";  ///< canyon::msg::TimeSyncSample in (input.vio dds)
   bool publish_stages = true;  ///< also canyon/bridged, canyon/alignment, canyon/prior, canyon/float
+  Ros2Options ros2;
 
   /// Empty if usable, else the first broken rule.
   [[nodiscard]] std::string validate() const;

@@ -36,6 +36,11 @@ inline constexpr char kTimingWriter[] = "timing_writer";
 inline constexpr char kTimingReader[] = "timing_reader";
 inline constexpr char kStageWriter[] = "stage_writer";  ///< canyon/bridged, /alignment, /prior, /float
 inline constexpr char kStageReader[] = "stage_reader";
+/// ROS 2's QoS profiles (ros2_outputs.hpp): sensor data (best effort, keep last 5) and default (reliable, keep 10).
+inline constexpr char kRos2SensorDataWriter[] = "ros2_sensor_data_writer";
+inline constexpr char kRos2SensorDataReader[] = "ros2_sensor_data_reader";
+inline constexpr char kRos2DefaultWriter[] = "ros2_default_writer";
+inline constexpr char kRos2DefaultReader[] = "ros2_default_reader";
 }  // namespace profile
 
 enum class ProfileKind { Participant, DataWriter, DataReader };

@@ -8,7 +8,8 @@
 //     and written once the epoch has moved on (StageObserver::handed_on): their DDS writes delay no epoch and, in the
 //     threaded pipeline, no other stage's thread (on two cores a write on the time bridge's thread held up the next
 //     stage's wake-up). The pending messages belong to the ambiguity stage's thread.
-// It owns the rover's writers (the solution and timing topics; with dds.publish_stages the stage outputs).
+// It owns the rover's writers (the solution and timing topics; with dds.publish_stages the stage outputs; with
+// ros2.enabled the ROS 2 topics: NavSatFix at once, Odometry and DiagnosticArray with the timing).
 
 #include <atomic>
 #include <cstdint>
@@ -17,6 +18,7 @@
 
 #include "canyon/config/rover_config.hpp"
 #include "canyon/dds/dds.hpp"
+#include "canyon/dds/ros2_msgs.hpp"
 #include "canyon/dds/rover_msgs.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/pipeline/byte_link.hpp"
@@ -48,8 +50,12 @@ class RoverOutputs {
 
   /// Closes the .pos, if any (a write error that happened on the way).
   Status close_pos();
-  /// Readers of the solution topic matched now.
-  [[nodiscard]] int solution_readers() const { return solution_->matched(); }
+  /// Readers matched now of the solution topic and, with ros2.enabled, of the three ROS 2 topics, counted together.
+  [[nodiscard]] int solution_readers() const {
+    int readers = solution_->matched();
+    if (ros2_fix_) readers += ros2_fix_->matched() + ros2_odometry_->matched() + ros2_diagnostics_->matched();
+    return readers;
+  }
   /// Waits until the solution and timing readers acknowledged every sample, at most timeout_s each.
   bool wait_for_acknowledgments(double timeout_s);
   /// Samples the writers refused (history full).
@@ -63,6 +69,8 @@ class RoverOutputs {
   void take_solved(const pipeline::SolvedEpoch& item);
   void handed_on(pipeline::Stage stage);
   void update_context(const pipeline::SolvedEpoch& item);
+  /// The ROS 2 messages of the epoch: NavSatFix written now, Odometry and DiagnosticArray pending.
+  void take_solved_ros2(const pipeline::SolvedEpoch& item);
 
   std::string rover_id_;
   std::unique_ptr<SolutionWriter> solution_;
@@ -71,6 +79,12 @@ class RoverOutputs {
   std::unique_ptr<AlignmentWriter> alignment_;
   std::unique_ptr<PriorWriter> prior_;
   std::unique_ptr<FloatWriter> float_;
+  config::Ros2Options ros2_;
+  core::LeapSecondTable leaps_;
+  std::unique_ptr<NavSatFixWriter> ros2_fix_;
+  std::unique_ptr<OdometryWriter> ros2_odometry_;
+  std::unique_ptr<DiagnosticsWriter> ros2_diagnostics_;
+  std::optional<core::Geodetic> enu_origin_;  // ros2.enu_origin_llh, else the first GNSS fix
   std::optional<io::PosWriter> pos_;
   std::shared_ptr<pipeline::ByteLink> gga_link_;
   const pipeline::RoverIngest* source_ = nullptr;
@@ -85,6 +99,8 @@ class RoverOutputs {
   std::optional<msg::FloatSolution> float_pending_;
   std::optional<msg::Alignment> alignment_pending_;
   std::optional<msg::StageTiming> timing_pending_;
+  std::optional<nav_msgs::msg::dds_::Odometry_> odometry_pending_;
+  std::optional<diagnostic_msgs::msg::dds_::DiagnosticArray_> diagnostics_pending_;
   std::atomic<std::uint64_t> refused_{0};  // the time bridge's and the ambiguity stage's threads publish
 };
 

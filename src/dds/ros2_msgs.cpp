@@ -1,0 +1,199 @@
+// canyon's solutions and stage timing as ROS 2 messages (see ros2_msgs.hpp).
+
+#include "canyon/dds/ros2_msgs.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+namespace canyon::dds {
+namespace {
+
+namespace sm = sensor_msgs::msg;
+namespace dm = diagnostic_msgs::msg;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+constexpr const char* kStageNames[6] = {"ingest", "time_bridge", "alignment", "prediction", "update", "ambiguity"};
+
+std_msgs::msg::dds_::Header_ header(const core::GpsTime& t, const std::string& frame_id,
+                                    const core::LeapSecondTable& leaps) {
+  std_msgs::msg::dds_::Header_ h;
+  h.stamp(ros_time(t, leaps));
+  h.frame_id(frame_id);
+  return h;
+}
+
+/// Row-major copy of a matrix into a ROS covariance array.
+template <int N, typename Array>
+void put_row_major(const Eigen::Matrix<double, N, N>& m, Array& out) {
+  std::size_t k = 0;
+  for (int r = 0; r < N; ++r) {
+    for (int c = 0; c < N; ++c) out[k++] = m(r, c);
+  }
+}
+
+dm::dds_::KeyValue_ key_value(const std::string& key, const std::string& value) {
+  dm::dds_::KeyValue_ kv;
+  kv.key(key);
+  kv.value(value);
+  return kv;
+}
+
+std::string number(double value, const char* format = "%.3f") {
+  if (!std::isfinite(value)) return "nan";
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+}  // namespace
+
+std::string ros2_dds_topic(const std::string& ros_topic) {
+  return "rt/" + (!ros_topic.empty() && ros_topic.front() == '/' ? ros_topic.substr(1) : ros_topic);
+}
+
+builtin_interfaces::msg::dds_::Time_ ros_time(const core::GpsTime& t, const core::LeapSecondTable& leaps) {
+  constexpr std::int64_t kGpsEpochPosixS = 315964800;  // 1980-01-06 00:00:00 UTC
+  const double whole_tow = std::floor(t.tow_s);
+  auto nanos = static_cast<std::int64_t>(std::llround((t.tow_s - whole_tow) * 1e9));
+  std::int64_t seconds = kGpsEpochPosixS + static_cast<std::int64_t>(t.week) * core::kSecondsPerWeek +
+                         static_cast<std::int64_t>(whole_tow) - leaps.gps_minus_utc_at_gps(t);
+  if (nanos >= 1000000000) {
+    seconds += 1;
+    nanos -= 1000000000;
+  }
+  builtin_interfaces::msg::dds_::Time_ time;
+  time.sec(static_cast<std::int32_t>(seconds));
+  time.nanosec(static_cast<std::uint32_t>(nanos));
+  return time;
+}
+
+std::uint16_t navsat_service(const core::ObsEpoch& rover) {
+  std::uint16_t service = 0;
+  for (const core::SatelliteObs& sat : rover.sats) {
+    switch (sat.sat.system) {
+      case core::Constellation::Gps:
+      case core::Constellation::Qzss: service |= sm::NavSatStatus_Constants::SERVICE_GPS; break;
+      case core::Constellation::Glonass: service |= sm::NavSatStatus_Constants::SERVICE_GLONASS; break;
+      case core::Constellation::Galileo: service |= sm::NavSatStatus_Constants::SERVICE_GALILEO; break;
+      case core::Constellation::BeiDou: service |= sm::NavSatStatus_Constants::SERVICE_COMPASS; break;
+    }
+  }
+  return service;
+}
+
+sm::dds_::NavSatFix_ to_navsatfix(const core::GpsTime& t, const core::Solution* solution, std::uint16_t service,
+                                  const config::Ros2Options& options, const core::LeapSecondTable& leaps) {
+  sm::dds_::NavSatFix_ fix;
+  fix.header(header(solution != nullptr ? solution->time : t, options.fix_frame_id, leaps));
+  sm::dds_::NavSatStatus_ status;
+  status.service(service);
+  const bool gnss = solution != nullptr && solution->status != core::SolutionStatus::VioFillIn &&
+                    solution->status != core::SolutionStatus::None;
+  if (!gnss) {
+    status.status(sm::NavSatStatus_Constants::STATUS_NO_FIX);
+    fix.status(status);
+    fix.latitude(kNaN);
+    fix.longitude(kNaN);
+    fix.altitude(kNaN);
+    fix.position_covariance_type(sm::NavSatFix_Constants::COVARIANCE_TYPE_UNKNOWN);
+    return fix;
+  }
+  status.status(solution->status == core::SolutionStatus::Single ? sm::NavSatStatus_Constants::STATUS_FIX
+                                                                 : sm::NavSatStatus_Constants::STATUS_GBAS_FIX);
+  fix.status(status);
+  const core::Geodetic g = core::ecef_to_geodetic(solution->p_E_m);
+  fix.latitude(g.lat_rad * kDegPerRad);
+  fix.longitude(g.lon_rad * kDegPerRad);
+  fix.altitude(g.height_m);
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(g);
+  const Eigen::Matrix3d P_N = R_NE * solution->P_E_m2 * R_NE.transpose();
+  std::array<double, 9> covariance{};
+  put_row_major<3>(P_N, covariance);
+  fix.position_covariance(covariance);
+  fix.position_covariance_type(sm::NavSatFix_Constants::COVARIANCE_TYPE_KNOWN);
+  return fix;
+}
+
+nav_msgs::msg::dds_::Odometry_ to_odometry(const core::Solution& solution, const core::Geodetic& origin,
+                                           const config::Ros2Options& options, const core::LeapSecondTable& leaps) {
+  nav_msgs::msg::dds_::Odometry_ odometry;
+  odometry.header(header(solution.time, options.map_frame_id, leaps));
+  odometry.child_frame_id(options.antenna_frame_id);
+  const Eigen::Vector3d p_N = core::ecef_to_enu(solution.p_E_m - core::geodetic_to_ecef(origin), origin);
+  const Eigen::Matrix3d R_NE = core::rotation_enu_from_ecef(origin);
+  geometry_msgs::msg::dds_::PoseWithCovariance_ pose;
+  pose.pose().position().x(p_N.x());
+  pose.pose().position().y(p_N.y());
+  pose.pose().position().z(p_N.z());
+  pose.pose().orientation().w(1.0);
+  Matrix6d pose_covariance = Matrix6d::Zero();
+  pose_covariance.topLeftCorner<3, 3>() = R_NE * solution.P_E_m2 * R_NE.transpose();
+  pose_covariance.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * kUnknownVariance;
+  put_row_major<6>(pose_covariance, pose.covariance());
+  odometry.pose(pose);
+  geometry_msgs::msg::dds_::TwistWithCovariance_ twist;  // canyon's solutions carry no velocity covariance
+  const Matrix6d twist_covariance = Matrix6d::Identity() * kUnknownVariance;
+  put_row_major<6>(twist_covariance, twist.covariance());
+  odometry.twist(twist);
+  return odometry;
+}
+
+std::string exact_status_name(std::uint8_t status) {
+  switch (status) {
+    case 1: return "fixed";
+    case 2: return "float";
+    case 5: return "single";
+    case 7: return "fill-in";
+    case core::kPartialFixStatus: return "partial fix";
+    default: return "none";
+  }
+}
+
+dm::dds_::DiagnosticArray_ to_diagnostics(const msg::StageTiming& timing, const core::Solution* solution,
+                                          const core::LeapSecondTable& leaps) {
+  const core::GpsTime t{timing.gps_week(), timing.gps_tow_s()};
+  dm::dds_::DiagnosticStatus_ status;
+  const std::string rover_id = timing.rover_id().to_string();
+  status.name("canyon rover: " + rover_id);
+  status.hardware_id(rover_id);
+  const std::uint8_t code = solution != nullptr ? core::exact_status(*solution) : 0;
+  std::vector<dm::dds_::KeyValue_> values;
+  values.push_back(key_value("status", exact_status_name(code)));
+  values.push_back(key_value("status_code", std::to_string(code)));
+  values.push_back(key_value("satellites", std::to_string(solution != nullptr ? solution->num_satellites : 0)));
+  values.push_back(key_value("correction_age_s", number(timing.correction_age_s())));
+  const msg::StageStamps& stamps = timing.stamps();
+  for (std::size_t k = 0; k < 6; ++k) {
+    const std::int64_t enter = stamps.enter_monotonic_ns()[k];
+    const std::int64_t exit = stamps.exit_monotonic_ns()[k];
+    values.push_back(key_value(std::string(kStageNames[k]) + "_ms",
+                               enter > 0 && exit >= enter ? number(1e-6 * double(exit - enter)) : "nan"));
+  }
+  const std::int64_t arrival = stamps.arrival_monotonic_ns();
+  const std::int64_t done = stamps.exit_monotonic_ns()[5];
+  values.push_back(
+      key_value("latency_ms", arrival > 0 && done >= arrival ? number(1e-6 * double(done - arrival)) : "nan"));
+  std::uint64_t waits = 0;
+  for (const std::uint64_t w : timing.queue_full_waits()) waits += w;
+  values.push_back(key_value("queue_full_waits", std::to_string(waits)));
+  values.push_back(key_value("vio_dropped", std::to_string(timing.vio_dropped())));
+  values.push_back(key_value("vio_late", std::to_string(timing.vio_late())));
+  values.push_back(key_value("base_late", std::to_string(timing.base_late())));
+  values.push_back(key_value("malformed_samples", std::to_string(timing.malformed_samples())));
+  status.values(values);
+  const bool troubled = code == 0 || timing.vio_dropped() > 0 || timing.malformed_samples() > 0;
+  status.level(troubled ? dm::DiagnosticStatus_Constants::WARN : dm::DiagnosticStatus_Constants::OK);
+  status.message(troubled ? (code == 0 ? "no solution" : "samples dropped or malformed")
+                          : "solved: " + exact_status_name(code));
+  dm::dds_::DiagnosticArray_ array;
+  array.header(header(t, "", leaps));
+  array.status({status});
+  return array;
+}
+
+}  // namespace canyon::dds
