@@ -93,6 +93,7 @@ std::vector<VioClockLine> lines_the_vio_follows(const TimeBridge& bridge, const 
 }
 
 core::GpsTime TimeBridge::to_gps_with_piece(std::int64_t t_ns, int k) const {
+  if (gps_clock_) return to_gps(t_ns);  // no pieces: the stamps are GPST
   return on_line(piece(std::max(k, 0)), t_ns);
 }
 

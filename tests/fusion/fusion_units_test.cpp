@@ -168,6 +168,12 @@ TEST(TimeBridgeTest, GpsClockStampsMapDirectly) {
   const core::GpsTime t = b.to_gps(std::int64_t{2266} * 604800 * 1000000000 + 316800'500000000);
   EXPECT_EQ(t.week, 2266);
   EXPECT_DOUBLE_EQ(t.tow_s, 316800.5);
+  // The VIO track maps each pose by its clock piece; a GPS clock has none (vio_clock: gps crashed here until
+  // 2026-11-29: the piece was read from an empty list).
+  const core::GpsTime by_piece =
+      b.to_gps_with_piece(std::int64_t{2266} * 604800 * 1000000000 + 316800'500000000, b.piece_of(0));
+  EXPECT_EQ(by_piece.week, 2266);
+  EXPECT_DOUBLE_EQ(by_piece.tow_s, 316800.5);
 }
 
 // --- VIO track ------------------------------------------------------------------------------------------------------
