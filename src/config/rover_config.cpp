@@ -127,8 +127,12 @@ const Table<R>& input_table() {
        at(&R::ntrip_gga_interval_s)},
       {"base_queue_frames", "", "dds: RTCM frames queued between the DDS listener and ingest; beyond: dropped",
        at(&R::base_queue_frames), Count{}},
-      {"vio", "", "fusion: file: estimator.vio and timesync | dds: VioPose and TimeSyncSample samples", at(&R::vio_dds),
-       Names<bool>{{{false, "file"}, {true, "dds"}}}},
+      {"vio", "",
+       "fusion: file: estimator.vio and timesync | dds: VioPose and TimeSyncSample samples | ros2: "
+       "nav_msgs/msg/Odometry on ros2.vio_topic",
+       at(&R::vio),
+       Names<RoverVioSource>{
+           {{RoverVioSource::File, "file"}, {RoverVioSource::Dds, "dds"}, {RoverVioSource::Ros2, "ros2"}}}},
       {"vio_wait_s", "s", "dds VIO: longest an epoch waits for the VIO to cover its time", at(&R::vio_wait_s)},
       {"vio_queue_poses", "", "dds VIO: poses queued between the DDS listener and the time bridge; beyond: dropped",
        at(&R::vio_queue_poses), Count{}},
@@ -164,6 +168,11 @@ const Table<Ros2Options>& ros2_table() {
       {"fix_frame_id", "", "NavSatFix header.frame_id (the antenna)", at(&O::fix_frame_id)},
       {"map_frame_id", "", "Odometry header.frame_id (the local ENU frame)", at(&O::map_frame_id)},
       {"antenna_frame_id", "", "Odometry child_frame_id", at(&O::antenna_frame_id)},
+      {"vio_topic", "", "input.vio ros2: nav_msgs/msg/Odometry in, T_OI (DDS topic rt/ + this)", at(&O::vio_topic)},
+      {"vio_frame_id", "", "input.vio ros2: the Odometry's expected header.frame_id (the VIO's odometry frame)",
+       at(&O::vio_frame_id)},
+      {"vio_child_frame_id", "", "input.vio ros2: the Odometry's expected child_frame_id (the IMU frame)",
+       at(&O::vio_child_frame_id)},
       {"enu_origin_llh", "", "ENU origin [lat_deg, lon_deg, h_m] (ellipsoidal height); []: the first GNSS fix",
        at(&O::enu_origin_llh)},
   };
@@ -219,8 +228,10 @@ std::string RoverConfig::validate() const {
   if (rover == RoverInputKind::Ubx && e.rover_obs.empty()) e.rover_obs = "-";
   const bool streams_nav = stream_ephemerides && (rover == RoverInputKind::Ubx || streamed_base());
   if (streams_nav && e.nav.empty()) e.nav = {"-"};  // ephemerides from the streams only
-  if (vio_dds) {
-    if (estimator.mode != ProcessMode::Fusion) return "input.vio dds needs estimator.mode fusion";
+  if (streamed_vio()) {
+    if (estimator.mode != ProcessMode::Fusion) {
+      return std::string("input.vio ") + (vio == RoverVioSource::Dds ? "dds" : "ros2") + " needs estimator.mode fusion";
+    }
     if (e.vio.empty()) e.vio = "-";  // the VIO streams in
     if (e.timesync.empty()) e.timesync = "-";
   }
@@ -252,7 +263,8 @@ std::string RoverConfig::validate() const {
       timesync_topic.empty()) {
     return "dds topics must not be empty";
   }
-  if (ros2.fix_topic.empty() || ros2.odometry_topic.empty() || ros2.diagnostics_topic.empty()) {
+  if (ros2.fix_topic.empty() || ros2.odometry_topic.empty() || ros2.diagnostics_topic.empty() ||
+      ros2.vio_topic.empty()) {
     return "ros2 topics must not be empty";
   }
   if (!ros2.enu_origin_llh.empty() &&

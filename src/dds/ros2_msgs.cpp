@@ -2,11 +2,14 @@
 
 #include "canyon/dds/ros2_msgs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numbers>
 #include <vector>
+
+#include <Eigen/Cholesky>
 
 namespace canyon::dds {
 namespace {
@@ -141,6 +144,61 @@ nav_msgs::msg::dds_::Odometry_ to_odometry(const core::Solution& solution, const
   put_row_major<6>(twist_covariance, twist.covariance());
   odometry.twist(twist);
   return odometry;
+}
+
+core::Matrix6d ros2_pose_covariance(const core::Matrix6d& xi_covariance, const core::Pose& T_OI) {
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = T_OI.rotation();
+  J.bottomRightCorner<3, 3>() = T_OI.rotation();
+  return J * xi_covariance * J.transpose();
+}
+
+Result<io::VioRecord> from_ros2_odometry(const nav_msgs::msg::dds_::Odometry_& odometry,
+                                         const config::Ros2Options& options, const core::LeapSecondTable& leaps) {
+  const auto& stamp = odometry.header().stamp();
+  const std::string which =
+      "Odometry at " + std::to_string(stamp.sec()) + "." + std::to_string(stamp.nanosec()) + " s (ROS time)";
+  if (odometry.header().frame_id() != options.vio_frame_id || odometry.child_frame_id() != options.vio_child_frame_id) {
+    return Error{which + ": frames '" + odometry.header().frame_id() + "' -> '" + odometry.child_frame_id() +
+                 "', expected '" + options.vio_frame_id + "' -> '" + options.vio_child_frame_id +
+                 "' (ros2.vio_frame_id, ros2.vio_child_frame_id)"};
+  }
+  const auto& pose = odometry.pose().pose();
+  const auto& covariance = odometry.pose().covariance();
+  const double values[7] = {pose.position().x(),    pose.position().y(),    pose.position().z(),
+                            pose.orientation().x(), pose.orientation().y(), pose.orientation().z(),
+                            pose.orientation().w()};
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!std::all_of(std::begin(values), std::end(values), finite) ||
+      !std::all_of(covariance.begin(), covariance.end(), finite)) {
+    return Error{which + ": a value of the pose or its covariance is not finite"};
+  }
+  io::VioRecord r;
+  constexpr std::int64_t kGpsEpochPosixS = 315964800;
+  const std::int64_t posix_s = stamp.sec();
+  // GPST - UTC at this instant: the table is keyed by GPST, one leap second apart at most near a step.
+  const core::GpsTime approx{static_cast<int>((posix_s - kGpsEpochPosixS) / core::kSecondsPerWeek),
+                             static_cast<double>((posix_s - kGpsEpochPosixS) % core::kSecondsPerWeek)};
+  const std::int64_t leap_s = leaps.gps_minus_utc_at_gps(approx);
+  r.t_ns = (posix_s - kGpsEpochPosixS + leap_s) * 1000000000LL + static_cast<std::int64_t>(stamp.nanosec());
+  r.T_OI.p = Eigen::Vector3d(values[0], values[1], values[2]);
+  const Eigen::Quaterniond q(values[6], values[3], values[4], values[5]);
+  const double norm = q.norm();
+  if (!(norm >= 0.5 && norm <= 1.5))
+    return Error{which + ": quaternion norm " + number(norm, "%.6f") + ", no rotation"};
+  r.T_OI.q = q.normalized();  // as the vio.csv reader does
+  Matrix6d C_ros;
+  for (int row = 0; row < 6; ++row) {
+    for (int col = 0; col < 6; ++col) C_ros(row, col) = covariance[static_cast<std::size_t>(row) * 6 + col];
+  }
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = r.T_OI.rotation().transpose();
+  J.bottomRightCorner<3, 3>() = r.T_OI.rotation().transpose();
+  r.covariance = J * (0.5 * (C_ros + C_ros.transpose())) * J.transpose();
+  if (Eigen::LLT<core::Matrix6d>(r.covariance).info() != Eigen::Success) {
+    return Error{which + ": the pose covariance is not positive definite"};
+  }
+  return r;
 }
 
 std::string exact_status_name(std::uint8_t status) {

@@ -94,6 +94,18 @@ Result<pipeline::BaseInput> open_base_input(const config::RoverConfig& config, c
   return input;  // without estimator.base_position: the stream's 1005/1006 (RoverIngestOptions)
 }
 
+/// Where the VIO comes from, for the start-up line.
+std::string vio_from(const config::RoverConfig& c) {
+  switch (c.vio) {
+    case config::RoverVioSource::Dds: return ", VIO from DDS " + c.vio_topic + " and " + c.timesync_topic;
+    case config::RoverVioSource::Ros2:
+      return ", VIO from ROS 2 Odometry " + c.ros2.vio_topic + " (" + c.ros2.vio_frame_id + " -> " +
+             c.ros2.vio_child_frame_id + ")";
+    case config::RoverVioSource::File: break;
+  }
+  return "";
+}
+
 }  // namespace
 
 RoverApp::RoverApp(RoverOptions options)
@@ -164,11 +176,11 @@ pipeline::BaseInput RoverApp::open_base(const io::ObsFilter& filter, const std::
 void RoverApp::build_estimator(commands::ProcessSummary& notes) {
   const config::ProcessConfig& est = config_.estimator;
   if (est.mode == config::ProcessMode::Fusion) {
-    auto track = config_.vio_dds ? Result<fusion::VioTrack>(fusion::VioTrack::streaming(est.fusion.vio))
-                                 : commands::load_vio_track(est, notes);
+    auto track = config_.streamed_vio() ? Result<fusion::VioTrack>(fusion::VioTrack::streaming(est.fusion.vio))
+                                        : commands::load_vio_track(est, notes);
     fusion_engine_ = std::make_unique<fusion::FusionEngine>(est.fusion, est.rtk_engine_options(), *ephemerides_,
                                                             p_E_base_, value_or_throw(std::move(track), kExitRuntime));
-    if (config_.vio_dds) open_live_vio();
+    if (config_.streamed_vio()) open_live_vio();
     estimator_ = std::make_unique<pipeline::FusionEstimator>(*fusion_engine_, live_vio_.get());
   } else {
     rtk_engine_ = std::make_unique<rtk::RtkEngine>(est.rtk_engine_options(), *ephemerides_, p_E_base_);
@@ -182,12 +194,17 @@ void RoverApp::open_live_vio() {
   pipeline::LiveVioOptions options;
   options.wait_s = config_.vio_wait_s;
   options.queue_poses = config_.vio_queue_poses;
-  options.vio_on_gps_time = config_.estimator.fusion.vio_on_gps_time;
+  // ROS 2 Odometry is stamped with ROS time, taken as UTC: GPST after the leap seconds (dds/ros2_msgs.hpp).
+  options.vio_on_gps_time = config_.estimator.fusion.vio_on_gps_time || config_.vio == config::RoverVioSource::Ros2;
   options.time_sync = config_.estimator.fusion.time_sync;
   options.time_sync.causal = true;
   if (const std::string e = options.validate(); !e.empty()) throw AppError(kExitRuntime, Error{"input.vio dds: " + e});
   live_vio_ = std::make_unique<pipeline::LiveVio>(*fusion_engine_, options, log_warning);
   pipeline::LiveVio* feed = live_vio_.get();
+  if (config_.vio == config::RoverVioSource::Ros2) {
+    open_ros2_vio(*feed);
+    return;
+  }
   vio_reader_ = value_or_throw(VioPoseReader::create(*participant_, config_.vio_topic, profile::kVioReader,
                                                      [feed](msg::VioPose&& m) {
                                                        auto pose = from_msg(m);
@@ -209,6 +226,28 @@ void RoverApp::open_live_vio() {
                                                              }
                                                            }),
                                     kExitRuntime);
+}
+
+void RoverApp::open_ros2_vio(pipeline::LiveVio& feed) {
+  // Refused samples (frames, values) are named in the log: the first ones, then every 100th, with the count.
+  auto refused = std::make_shared<std::atomic<std::uint64_t>>(0);
+  const config::Ros2Options options = config_.ros2;
+  ros2_vio_reader_ = value_or_throw(
+      OdometryReader::create(
+          *participant_, ros2_dds_topic(options.vio_topic), profile::kRos2SensorDataReader,
+          [&feed, refused, options, leaps = core::builtin_leap_seconds()](nav_msgs::msg::dds_::Odometry_&& m) {
+            auto pose = from_ros2_odometry(m, options, leaps);
+            if (pose) {
+              feed.push_pose(std::move(*pose));
+              return;
+            }
+            const std::uint64_t n = refused->fetch_add(1) + 1;
+            if (n <= 10 || n % 100 == 0) {
+              spdlog::warn("VIO (ROS 2 {}): {} (sample dropped; {} so far)", options.vio_topic, pose.error().message,
+                           n);
+            }
+          }),
+      kExitRuntime);
 }
 
 void RoverApp::open_pos() {
@@ -259,8 +298,7 @@ void RoverApp::log_start() const {
                                                                          : shown(c.base_source);
   spdlog::info(
       "rover '{}': {} mode, rover from {}, base from {}, {} pipeline, pace {}; publishing {} and {} on domain {}",
-      c.rover_id, config::mode_name(c.estimator.mode), rover_from,
-      base_from + (c.vio_dds ? ", VIO from DDS " + c.vio_topic + " and " + c.timesync_topic : ""),
+      c.rover_id, config::mode_name(c.estimator.mode), rover_from, base_from + vio_from(c),
       c.pipeline.threaded ? "threaded" : "sequential", c.pace, c.solution_topic, c.timing_topic, c.domain);
   for (std::size_t s = 0; s < pipeline::kNumStages; ++s) {
     const std::vector<int>& cpus = c.pipeline.cpu_affinity[s];

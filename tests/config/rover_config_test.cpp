@@ -138,14 +138,26 @@ TEST(RoverConfig, VioFromDds) {
                               "rover.yaml");
   ASSERT_TRUE(c) << c.error().to_string();
   EXPECT_EQ(c->validate(), "");  // no vio.csv or timesync.csv needed
-  EXPECT_TRUE(c->vio_dds);
+  EXPECT_EQ(c->vio, RoverVioSource::Dds);
   EXPECT_EQ(c->vio_wait_s, 0.5);
   EXPECT_EQ(c->vio_queue_poses, 100U);
   EXPECT_EQ(c->vio_topic, "a/vio");
   auto again = parse_rover_config(YAML::Load(to_yaml(*c)), "printed");
   ASSERT_TRUE(again) << again.error().to_string();
   EXPECT_TRUE(*again == *c);
-  EXPECT_NE(error(fusion + "input: {vio: udp}\n").find("file or dds"), std::string::npos);
+  EXPECT_NE(error(fusion + "input: {vio: udp}\n").find("file, dds or ros2"), std::string::npos);
+  // ROS 2 Odometry: no files needed either; the frames it expects are keys of ros2.
+  auto ros2 = parse_rover_config(
+      YAML::Load(fusion + "input: {vio: ros2}\nros2: {vio_topic: ov/odom, vio_frame_id: global, vio_child_frame_id: "
+                          "imu0}\n"),
+      "rover.yaml");
+  ASSERT_TRUE(ros2) << ros2.error().to_string();
+  EXPECT_EQ(ros2->validate(), "");
+  EXPECT_EQ(ros2->vio, RoverVioSource::Ros2);
+  EXPECT_EQ(ros2->ros2.vio_frame_id, "global");
+  EXPECT_NE(error("estimator: {mode: rtk, rover: r.obs, base: b.obs, nav: [n.rnx]}\ninput: {vio: ros2}\n")
+                .find("input.vio ros2 needs estimator.mode fusion"),
+            std::string::npos);
   EXPECT_NE(error(fusion + "input: {vio: dds, vio_wait_s: -1}\n").find("input.vio_wait_s"), std::string::npos);
   EXPECT_NE(error(fusion + "input: {vio: dds, vio_queue_poses: 3}\n").find("input.vio_queue_poses"), std::string::npos);
   EXPECT_NE(error("estimator: {mode: rtk, rover: r.obs, base: b.obs, nav: [n.rnx]}\ninput: {vio: dds}\n")

@@ -7,7 +7,8 @@
 //       ends after N samples, or S seconds (default 60) without one after the first.
 //   canyon_ros2_raw publish --topic T --type NAME --qos sensor|default --in FILE [--rate HZ] [--wait-readers N]
 //                           [--domain D]
-//       publishes FILE's payloads (same framing) in order at HZ (default 50) once N readers matched (default 1).
+//       publishes FILE's payloads (same framing) in order at HZ (default 50) once N readers matched (default 1), and
+//       a second more (the readers' side of the discovery).
 // QoS: ROS 2's sensor-data (best effort, keep last 5) or default (reliable, keep last 10) profiles of the shipped
 // file, config/dds/canyon_profiles.xml. Exit 0 done, 1 a DDS or file error, 2 bad command line, 3 timeout.
 
@@ -190,6 +191,8 @@ int run(const Args& a) {
     if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(a.timeout_s)) return 3;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  // Matched on this side does not mean the reader has matched this writer yet (discovery is two-way): settle.
+  std::this_thread::sleep_for(std::chrono::seconds(1));
   const auto period = std::chrono::duration<double>(1.0 / a.rate_hz);
   auto next = std::chrono::steady_clock::now();
   for (Bytes frame : frames) {

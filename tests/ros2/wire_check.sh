@@ -17,7 +17,7 @@ command -v npm > /dev/null || { echo "SKIP: npm not found (scripts/setup.sh inst
 # The decoders, locked, into the build folder (never the source tree); install scripts are not run.
 decoders=$build/ros2-decoders
 mkdir -p "$decoders"
-cp "$here/package.json" "$here/package-lock.json" "$here/wire_check.mjs" "$decoders/"
+cp "$here/package.json" "$here/package-lock.json" "$here/wire_check.mjs" "$here/encode_odometry.mjs" "$decoders/"
 if [[ ! -f $decoders/node_modules/.package-lock.json || $here/package-lock.json -nt $decoders/node_modules/.package-lock.json ]]; then
   (cd "$decoders" && npm ci --no-audit --no-fund --ignore-scripts --loglevel=error) ||
     { echo "SKIP: npm ci failed for the ROS 2 decoders (is the npm registry reachable?)"; exit 77; }
@@ -47,17 +47,66 @@ input: {pace: 5}
 dds: {domain: $domain}
 ros2: {enabled: true}
 EOF
-record() {  # topic type qos file
-  "$raw" record --topic "$1" --type "$2" --qos "$3" --out "$tmp/$4" --count "$epochs" --timeout 30 \
+record() {  # topic type qos file count (0: until 5 s without a sample)
+  "$raw" record --topic "$1" --type "$2" --qos "$3" --out "$tmp/$4" --count "$5" --timeout "$([[ $5 == 0 ]] && echo 5 || echo 30)" \
     --domain "$domain" 2> "$tmp/$4.log" &
   pids+=($!)
 }
-record rt/canyon/fix sensor_msgs::msg::dds_::NavSatFix_ sensor fix.bin
-record rt/canyon/odometry nav_msgs::msg::dds_::Odometry_ sensor odom.bin
-record rt/diagnostics diagnostic_msgs::msg::dds_::DiagnosticArray_ default diag.bin
+record rt/canyon/fix sensor_msgs::msg::dds_::NavSatFix_ sensor fix.bin "$epochs"
+record rt/canyon/odometry nav_msgs::msg::dds_::Odometry_ sensor odom.bin 0  # from the first fix on
+record rt/diagnostics diagnostic_msgs::msg::dds_::DiagnosticArray_ default diag.bin "$epochs"
 "$canyon" rover --config "$tmp/rover.yaml" -q --wait-for-subscribers 3 --wait-timeout 30
-for p in "${pids[@]:0:1}" "${pids[@]:2:1}"; do wait "$p" || { echo "FAIL: a recorder missed samples: $(cat "$tmp"/*.log)"; exit 1; }; done
-kill "${pids[1]}" 2> /dev/null || true  # Odometry starts at the first fix: fewer samples than epochs
-wait "${pids[1]}" 2> /dev/null || true
+for p in "${pids[@]}"; do wait "$p" || { echo "FAIL: a recorder missed samples: $(cat "$tmp"/*.log)"; exit 1; }; done
 cat "$tmp"/*.bin.log
 node "$decoders/wire_check.mjs" "$tmp"
+
+# VIO in: Odometry -> canyon rover equals the same poses from a file (vio_gps.csv: the poses on GPST, no
+# cross-covariances, as Odometry carries none).
+node "$decoders/encode_odometry.mjs" "$tmp/sim/vio.csv" "$tmp/sim/timesync.csv" "$tmp"
+vio_rover() {  # name vio-source
+  cat > "$tmp/$1.yaml" << EOF
+estimator:
+  mode: fusion
+  rover: $tmp/sim/rover.obs
+  base: $tmp/sim/base.obs
+  nav: [$tmp/sim/nav.rnx]
+  vio: $tmp/vio_gps.csv
+  fusion: {vio_clock: gps}
+  out: $tmp/$1.pos
+rover_id: walker
+input: {pace: 5, vio: $2, vio_wait_s: 5}
+dds: {domain: $domain}
+EOF
+}
+vio_rover from_file file
+vio_rover from_ros2 ros2
+"$canyon" rover --config "$tmp/from_file.yaml" -q > "$tmp/from_file.log" 2>&1
+publish() {  # frames-file log
+  "$raw" publish --topic rt/vio/odometry --type nav_msgs::msg::dds_::Odometry_ --qos default --in "$1" --rate 200 \
+    --wait-readers 1 --timeout 30 --domain "$domain" 2> "$2" &
+  pids+=($!)
+}
+publish "$tmp/odometry.bin" "$tmp/publish.log"
+"$canyon" rover --config "$tmp/from_ros2.yaml" -q > "$tmp/from_ros2.log" 2>&1
+wait "${pids[-1]}" || { echo "FAIL: publishing the Odometry: $(cat "$tmp/publish.log")"; exit 1; }
+if ! cmp -s <(grep -v '^%' "$tmp/from_file.pos") <(grep -v '^%' "$tmp/from_ros2.pos"); then
+  echo "FAIL: the Odometry-driven rover differs from the same poses from a file:"
+  grep -h "VIO over DDS\|sample dropped" "$tmp/from_ros2.log" "$tmp/publish.log" || true
+  diff <(grep -v '^%' "$tmp/from_file.pos") <(grep -v '^%' "$tmp/from_ros2.pos") | head -5
+  exit 1
+fi
+echo "input.vio ros2: $(grep -vc '^%' "$tmp/from_ros2.pos") solutions equal, byte for byte, to the same poses from a file"
+
+# Bad input: refused sample by sample, each named.
+node "$decoders/encode_odometry.mjs" "$tmp/sim/vio.csv" "$tmp/sim/timesync.csv" "$tmp" --bad
+publish "$tmp/odometry.bin" "$tmp/publish_bad.log"
+"$canyon" rover --config "$tmp/from_ros2.yaml" > "$tmp/bad.log" 2>&1
+wait "${pids[-1]}" || { echo "FAIL: publishing the bad Odometry: $(cat "$tmp/publish_bad.log")"; exit 1; }
+for what in "pose or its covariance is not finite" "frames 'world' -> 'imu', expected 'odom' -> 'imu'" \
+  "frames 'odom' -> 'camera', expected 'odom' -> 'imu'"; do
+  grep -qF "$what" "$tmp/bad.log" || { echo "FAIL: the log does not name '$what':"; grep -i "vio\|warn" "$tmp/bad.log" | head; exit 1; }
+done
+solved=$(grep -v '^%' "$tmp/from_ros2.pos" | awk '$6 != 0' | wc -l)
+[[ $solved -eq $epochs ]] || { echo "FAIL: $solved of $epochs epochs solved with three bad Odometry samples"; exit 1; }
+grep "sample dropped" "$tmp/bad.log" | sed 's/^.*VIO/VIO/' | head -3
+echo "bad Odometry: 3 samples refused and named, all $epochs epochs solved"

@@ -16,9 +16,12 @@ namespace canyon::config {
 
 enum class RoverInputKind { Rinex, Ubx };
 enum class RoverBaseSource { File, Dds, Ntrip, Tcp };
+/// Where a fusion rover's VIO comes from: estimator.vio and timesync files, canyon's VioPose and TimeSyncSample over
+/// DDS, or a ROS 2 nav_msgs/msg/Odometry topic (ros2.vio_topic; stamps on ROS time, see dds/ros2_msgs.hpp).
+enum class RoverVioSource { File, Dds, Ros2 };
 [[nodiscard]] const char* rover_base_source_name(RoverBaseSource source);
 
-/// ROS 2-compatible outputs (dds/ros2_outputs.hpp): the solution as sensor_msgs/msg/NavSatFix and nav_msgs/msg/Odometry
+/// ROS 2-compatible topics (dds/ros2_msgs.hpp): the solution as sensor_msgs/msg/NavSatFix and nav_msgs/msg/Odometry
 /// (local ENU), the stage timing and canyon's exact status as diagnostic_msgs/msg/DiagnosticArray, on ROS 2's topic
 /// names ("rt/" + topic) and type names. Off by default.
 struct Ros2Options {
@@ -30,6 +33,10 @@ struct Ros2Options {
   std::string map_frame_id = "map";                ///< Odometry header.frame_id: the local ENU frame
   std::string antenna_frame_id = "gnss_antenna";   ///< Odometry child_frame_id
   std::vector<double> enu_origin_llh;              ///< [lat_deg, lon_deg, h_m] of the ENU origin; empty: first fix
+  // input.vio ros2: the VIO as nav_msgs/msg/Odometry, pose T_OI of child frame I in frame O.
+  std::string vio_topic = "vio/odometry";  ///< Odometry in (DDS topic rt/vio/odometry)
+  std::string vio_frame_id = "odom";       ///< the expected header.frame_id: the VIO's odometry frame O
+  std::string vio_child_frame_id = "imu";  ///< the expected child_frame_id: the IMU frame I
 };
 
 struct RoverConfig {
@@ -47,8 +54,8 @@ struct RoverConfig {
   double base_wait_s = 2.0;        ///< how long a rover epoch waits for its base epoch (streamed), from when it is due
   double ntrip_gga_interval_s = 0.0;  ///< base ntrip: upload the rover's latest position as GGA this often (0: never)
   std::size_t base_queue_frames = 4096;  ///< RTCM frames between the DDS listener and ingest; beyond: dropped, counted
-  bool vio_dds = false;                  ///< fusion: VIO and time sync from DDS (vio_topic, timesync_topic), not files
-  double vio_wait_s = 0.2;               ///< dds VIO: longest an epoch waits for the VIO to cover it (s)
+  RoverVioSource vio = RoverVioSource::File;  ///< fusion: VIO from files, DDS (vio_topic, timesync_topic) or ROS 2
+  double vio_wait_s = 0.2;                    ///< dds VIO: longest an epoch waits for the VIO to cover it (s)
   std::size_t vio_queue_poses = 4096;  ///< dds VIO: poses between the DDS listener and the time bridge; beyond: dropped
   pipeline::PipelineOptions pipeline{true, 64};  ///< threaded, queue_capacity
   int domain = 0;                                ///< DDS domain id
@@ -63,6 +70,8 @@ struct RoverConfig {
 
   /// Empty if usable, else the first broken rule.
   [[nodiscard]] std::string validate() const;
+  /// Whether the VIO streams in (dds, ros2), not from files.
+  [[nodiscard]] bool streamed_vio() const { return vio != RoverVioSource::File; }
   /// Whether the base comes as RTCM 3 that streams in (dds, ntrip, tcp).
   [[nodiscard]] bool streamed_base() const { return base != RoverBaseSource::File; }
 };

@@ -25,6 +25,7 @@
 #include "canyon/core/solution.hpp"
 #include "canyon/core/time.hpp"
 #include "canyon/dds/dds.hpp"
+#include "canyon/io/vio_file.hpp"
 
 #include "Ros2Messages.h"
 #include "Ros2MessagesPubSubTypes.h"
@@ -34,6 +35,7 @@ namespace canyon::dds {
 
 using NavSatFixWriter = DdsWriter<sensor_msgs::msg::dds_::NavSatFix_, sensor_msgs::msg::dds_::NavSatFix_PubSubType>;
 using OdometryWriter = DdsWriter<nav_msgs::msg::dds_::Odometry_, nav_msgs::msg::dds_::Odometry_PubSubType>;
+using OdometryReader = DdsReader<nav_msgs::msg::dds_::Odometry_, nav_msgs::msg::dds_::Odometry_PubSubType>;
 using DiagnosticsWriter =
     DdsWriter<diagnostic_msgs::msg::dds_::DiagnosticArray_, diagnostic_msgs::msg::dds_::DiagnosticArray_PubSubType>;
 
@@ -65,6 +67,21 @@ inline constexpr double kUnknownVariance = 1e9;
 [[nodiscard]] diagnostic_msgs::msg::dds_::DiagnosticArray_ to_diagnostics(const msg::StageTiming& timing,
                                                                           const core::Solution* solution,
                                                                           const core::LeapSecondTable& leaps);
+
+/// A VIO pose from a ROS 2 Odometry (input.vio ros2). Assumed, as ROS 2 defines Odometry and as VIO nodes (OpenVINS)
+/// publish it: the pose is T_OI, the IMU (child_frame_id) in the VIO's odometry frame (header.frame_id); its 6x6
+/// covariance is row-major over (x, y, z, rotation about x, y, z) in header.frame_id. canyon's covariance is of the
+/// right perturbation xi_OI = [delta p; delta theta] in the IMU frame, so it is rotated by R_IO: C = J C_ros J^T with
+/// J = diag(R_IO, R_IO). Odometry has no cross-covariance with the previous pose: none (zero, as a vio.csv without
+/// its 36 columns). The twist is not used. header.stamp is ROS time (POSIX, UTC) and becomes GPST with the leap
+/// seconds: the VIO host's clock must follow GPS time (PTP, or NTP/chrony with a PPS), so no time-sync pairs are
+/// needed. Errors (the sample is refused): frame ids other than `options.vio_frame_id` / `vio_child_frame_id`, a value
+/// that is not finite, a quaternion that is no rotation, a covariance that is not positive definite.
+Result<io::VioRecord> from_ros2_odometry(const nav_msgs::msg::dds_::Odometry_& odometry,
+                                         const config::Ros2Options& options, const core::LeapSecondTable& leaps);
+
+/// The inverse of from_ros2_odometry's covariance mapping: canyon's xi_OI covariance as Odometry's, in frame O.
+[[nodiscard]] core::Matrix6d ros2_pose_covariance(const core::Matrix6d& xi_covariance, const core::Pose& T_OI);
 
 /// canyon's exact status name ("fixed", "float", "partial fix", "single", "fill-in", "none").
 [[nodiscard]] std::string exact_status_name(std::uint8_t status);

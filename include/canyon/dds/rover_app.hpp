@@ -18,6 +18,7 @@
 #include "canyon/config/rover_config.hpp"
 #include "canyon/dds/app.hpp"
 #include "canyon/dds/dds.hpp"
+#include "canyon/dds/ros2_msgs.hpp"
 #include "canyon/dds/rover_msgs.hpp"
 #include "canyon/dds/rover_outputs.hpp"
 #include "canyon/dds/rtcm_frame.hpp"
@@ -69,6 +70,8 @@ class RoverApp {
   void create_rtcm_reader();
   void build_estimator(commands::ProcessSummary& notes);
   void open_live_vio();
+  /// input.vio ros2: the Odometry reader that fills the live VIO (refused samples named in the log).
+  void open_ros2_vio(pipeline::LiveVio& feed);
   void open_pos();
   pipeline::BaseInput open_base(const io::ObsFilter& filter, const std::optional<core::GpsTime>& rover_start);
   void build_pipeline(pipeline::RoverInput rover, pipeline::BaseInput base);
@@ -95,6 +98,7 @@ class RoverApp {
   std::unique_ptr<pipeline::LiveVio> live_vio_;
   std::unique_ptr<VioPoseReader> vio_reader_;
   std::unique_ptr<TimeSyncReader> timesync_reader_;
+  std::unique_ptr<OdometryReader> ros2_vio_reader_;  // input.vio ros2
   std::unique_ptr<pipeline::EpochEstimator> estimator_;
   std::unique_ptr<pipeline::EphemerisFeed> feed_;
   std::unique_ptr<pipeline::RoverIngest> source_;
