@@ -1,0 +1,105 @@
+#pragma once
+// MCAP recordings (https://mcap.dev/spec, version 0): the container Foxglove and the `mcap` tools open, written and
+// read by canyon itself (no MCAP library is packaged for Debian 12).
+//
+// Writer: the magic, a Header (profile "", library "canyon"), then in the data section each Schema and Channel
+// before its first Message, the Messages in the order given, a DataEnd (data CRC 0: not computed), and a summary
+// section: every Schema and Channel again, a Statistics record (message count, first and last log time, messages per
+// channel) and a SummaryOffset per group; the Footer and the magic. Messages are not chunked and not indexed
+// (readers then scan the data section; files of a session stay small enough). canyon's schemas are OMG IDL
+// ("omgidl", the IDL text of the type) with CDR-encoded messages ("cdr"): the serialized DDS payloads as they came
+// off the wire, encapsulation header included.
+// Reader: the data section in order (Schema, Channel, Message; other records skipped), so that a file cut short
+// still yields every message before the cut. Errors name the file and the byte offset: a bad magic, a record that
+// runs past the end (a file cut short: the messages before it were read), a message on an unknown channel.
+
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "canyon/core/result.hpp"
+
+namespace canyon::io {
+
+struct McapSchema {
+  std::uint16_t id = 0;
+  std::string name;      ///< e.g. "canyon::msg::Solution"
+  std::string encoding;  ///< "omgidl"
+  std::string data;      ///< the IDL text
+};
+
+struct McapChannel {
+  std::uint16_t id = 0;
+  std::uint16_t schema_id = 0;
+  std::string topic;             ///< the DDS topic, e.g. "canyon/solution"
+  std::string message_encoding;  ///< "cdr"
+  std::map<std::string, std::string> metadata;
+};
+
+struct McapMessage {
+  std::uint16_t channel_id = 0;
+  std::uint32_t sequence = 0;
+  std::uint64_t log_time_ns = 0;      ///< when canyon received it (ns since the UNIX epoch)
+  std::uint64_t publish_time_ns = 0;  ///< the publisher's source timestamp (ns since the UNIX epoch)
+  std::vector<std::uint8_t> data;
+};
+
+class McapWriter {
+ public:
+  /// Creates (truncates) `path`, creating its folder, and writes the magic and the Header.
+  static Result<McapWriter> create(const std::string& path);
+  McapWriter(McapWriter&&) noexcept = default;
+  McapWriter& operator=(McapWriter&&) noexcept = default;
+  ~McapWriter() = default;
+
+  /// A schema; its id (1, 2, ...). Written now.
+  Result<std::uint16_t> add_schema(const std::string& name, const std::string& encoding, const std::string& data);
+  /// A channel on a schema; its id (0, 1, ...). Written now.
+  Result<std::uint16_t> add_channel(std::uint16_t schema_id, const std::string& topic,
+                                    const std::string& message_encoding);
+  /// A message on a channel (sequence and times as given).
+  Status write(const McapMessage& message);
+  /// The DataEnd, the summary, the Footer and the closing magic; reports a write error that happened on the way.
+  Status close();
+  [[nodiscard]] std::uint64_t messages() const { return message_count_; }
+  [[nodiscard]] std::uint64_t bytes() const { return offset_; }
+
+ private:
+  struct FileCloser {
+    void operator()(std::FILE* f) const {
+      if (f != nullptr) std::fclose(f);
+    }
+  };
+  McapWriter(std::unique_ptr<std::FILE, FileCloser> file, std::string path)
+      : file_(std::move(file)), path_(std::move(path)) {}
+  Status put(const std::string& bytes);
+
+  std::unique_ptr<std::FILE, FileCloser> file_;
+  std::string path_;
+  std::uint64_t offset_ = 0;
+  std::vector<McapSchema> schemas_;
+  std::vector<McapChannel> channels_;
+  std::map<std::uint16_t, std::uint64_t> channel_counts_;
+  std::uint64_t message_count_ = 0;
+  std::uint64_t first_log_ns_ = 0, last_log_ns_ = 0;
+  bool closed_ = false;
+};
+
+/// Everything a recording holds (McapReader).
+struct McapContent {
+  std::map<std::uint16_t, McapSchema> schemas;
+  std::map<std::uint16_t, McapChannel> channels;
+  std::vector<McapMessage> messages;
+  bool complete = false;  ///< the Footer and the closing magic were there
+};
+
+/// Reads a recording (see above). A file cut short is an Error naming the byte offset of the cut; read_mcap_partial
+/// returns what came before it instead, with `complete` false.
+Result<McapContent> read_mcap(const std::string& path);
+Result<McapContent> read_mcap_partial(const std::string& path, std::string* problem);
+
+}  // namespace canyon::io
