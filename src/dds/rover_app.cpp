@@ -198,7 +198,10 @@ void RoverApp::open_live_vio() {
   options.vio_on_gps_time = config_.estimator.fusion.vio_on_gps_time || config_.vio == config::RoverVioSource::Ros2;
   options.time_sync = config_.estimator.fusion.time_sync;
   options.time_sync.causal = true;
-  if (const std::string e = options.validate(); !e.empty()) throw AppError(kExitRuntime, Error{"input.vio dds: " + e});
+  if (const std::string e = options.validate(); !e.empty()) {
+    const char* source = config_.vio == config::RoverVioSource::Ros2 ? "input.vio ros2: " : "input.vio dds: ";
+    throw AppError(kExitRuntime, Error{source + e});
+  }
   live_vio_ = std::make_unique<pipeline::LiveVio>(*fusion_engine_, options, log_warning);
   pipeline::LiveVio* feed = live_vio_.get();
   if (config_.vio == config::RoverVioSource::Ros2) {
