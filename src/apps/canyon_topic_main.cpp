@@ -37,16 +37,21 @@ int run(dds::TopicTool tool, int argc, char** argv) {
   dds::TopicOptions o;
   o.tool = tool;
   o.until_gone = tool != dds::TopicTool::Echo;
+  std::vector<std::string> topics;
   if (tool != dds::TopicTool::Monitor) {
-    cli.add_option("topic", o.topic,
+    cli.add_option("topic", topics,
                    "canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior, "
-                   "canyon/float, canyon/vio or canyon/timesync")
+                   "canyon/float, canyon/vio or canyon/timesync (record to .mcap: any number of them, and the ROS "
+                   "2 topics rt/canyon/fix, rt/canyon/odometry, rt/diagnostics)")
         ->required();
   } else {
     add_monitor_options(cli, o);
   }
   if (tool == dds::TopicTool::Record) {
-    cli.add_option("--out", o.out, "Output file: .pos, .nmea or .csv (solutions), .rtcm3 (canyon/rtcm), .csv")
+    cli.add_option(
+           "--out", o.out,
+           "Output file: .pos, .nmea or .csv (solutions), .rtcm3 (canyon/rtcm), .csv; .mcap: every topic given, "
+           "as it came off the wire, with its schema (Foxglove, mcap tools, canyon play)")
         ->required();
   }
   cli.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 232));
@@ -62,6 +67,10 @@ int run(dds::TopicTool tool, int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : dds::kExitUsage;
+  }
+  if (!topics.empty()) {
+    o.topic = topics.front();
+    o.more_topics.assign(topics.begin() + 1, topics.end());
   }
 #ifdef CANYON_WITH_DASHBOARD
   if (o.http_port >= 0 && o.dashboard.web_dir.empty()) {

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <thread>
 #include <utility>
 
@@ -63,10 +64,54 @@ void TopicApp::add_reader(const std::string& topic, const char* profile, void (T
   readers_.push_back(std::make_unique<Holder>(value_or_throw(std::move(reader), kExitRuntime)));
 }
 
+/// A reader of one topic's samples as bytes (record to .mcap).
+struct TopicApp::McapReader final : AnyReader, fdds::DataReaderListener {
+  McapReader(TopicApp& app, std::uint16_t channel) : app(app), channel(channel) {}
+  ~McapReader() override {
+    if (reader != nullptr) {
+      reader->set_listener(nullptr);
+      subscriber->delete_datareader(reader);
+    }
+    if (subscriber != nullptr) app.participant_->get()->delete_subscriber(subscriber);
+  }
+  McapReader(const McapReader&) = delete;
+  McapReader& operator=(const McapReader&) = delete;
+  [[nodiscard]] int matched() const override { return matched_now.load(); }
+  void on_subscription_matched(fdds::DataReader* /*reader*/, const fdds::SubscriptionMatchedStatus& info) override {
+    matched_now.store(info.current_count);
+  }
+  void on_data_available(fdds::DataReader* r) override {
+    RawSample bytes;
+    fdds::SampleInfo info;
+    while (r->take_next_sample(&bytes, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const auto publish_ns =
+          static_cast<std::uint64_t>(info.source_timestamp.seconds()) * 1000000000ULL + info.source_timestamp.nanosec();
+      app.on_mcap_sample(channel, std::move(bytes), publish_ns);
+    }
+  }
+  TopicApp& app;
+  std::uint16_t channel;
+  fdds::Subscriber* subscriber = nullptr;
+  fdds::DataReader* reader = nullptr;
+  std::atomic<int> matched_now{0};
+};
+
 TopicApp::TopicApp(TopicOptions options)
     : options_(std::move(options)), solutions_(ends_with(options_.topic, "solution")), model_(core::pipeline_now_ns()) {
   const bool monitor = options_.tool == TopicTool::Monitor;
-  if (!monitor && !known_topic(options_.topic)) {
+  const bool mcap = options_.tool == TopicTool::Record && ends_with(options_.out, ".mcap");
+  if (!options_.more_topics.empty() && !mcap) {
+    throw AppError(kExitUsage, Error{"several topics need a recording to .mcap (--out SESSION.mcap)"});
+  }
+  if (mcap) {
+    for (const std::string& topic : mcap_topics()) {
+      if (!recorded_topic(topic)) {
+        throw AppError(kExitUsage, Error{"unknown topic '" + topic + "': " + kKnownTopics +
+                                         ", or rt/canyon/fix, rt/canyon/odometry, rt/diagnostics"});
+      }
+    }
+  } else if (!monitor && !known_topic(options_.topic)) {
     throw AppError(kExitUsage, Error{"unknown topic '" + options_.topic + "': " + kKnownTopics});
   }
   const ProfileSet profiles = value_or_throw(load_profiles(options_.profiles), kExitUsage);
@@ -92,8 +137,62 @@ void TopicApp::start_dashboard() {
 #endif
 }
 
+std::vector<std::string> TopicApp::mcap_topics() const {
+  std::vector<std::string> topics{options_.topic};
+  topics.insert(topics.end(), options_.more_topics.begin(), options_.more_topics.end());
+  return topics;
+}
+
+void TopicApp::create_mcap_readers() {
+  std::map<std::string, std::uint16_t> schemas;  // by type name
+  for (const std::string& topic : mcap_topics()) {
+    const RecordedTopic recorded = *recorded_topic(topic);
+    if (schemas.count(recorded.type_name) == 0) {
+      schemas[recorded.type_name] =
+          value_or_throw(mcap_->add_schema(recorded.type_name, "omgidl", recorded.schema), kExitRuntime);
+    }
+    const std::uint16_t channel =
+        value_or_throw(mcap_->add_channel(schemas[recorded.type_name], topic, "cdr"), kExitRuntime);
+    mcap_sequence_.push_back(0);
+    auto dds_topic = value_or_throw(
+        participant_->topic(topic, fdds::TypeSupport(new RawSampleType(recorded.type_name))), kExitRuntime);
+    auto holder = std::make_unique<McapReader>(*this, channel);
+    holder->subscriber = participant_->get()->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    if (holder->subscriber == nullptr) throw AppError(kExitRuntime, Error{"DDS: cannot create a subscriber"});
+    holder->reader =
+        holder->subscriber->create_datareader_with_profile(dds_topic, recorded.reader_profile, holder.get());
+    if (holder->reader == nullptr) {
+      throw AppError(kExitRuntime, Error{"DDS: cannot create a data reader on topic '" + topic + "'"});
+    }
+    readers_.push_back(std::move(holder));
+  }
+}
+
+void TopicApp::on_mcap_sample(std::uint16_t channel, RawSample&& bytes, std::uint64_t publish_time_ns) {
+  const auto log_ns = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
+  const std::lock_guard lock(mutex_);
+  io::McapMessage m;
+  m.channel_id = channel;
+  m.sequence = mcap_sequence_[channel]++;
+  m.log_time_ns = log_ns;
+  m.publish_time_ns = publish_time_ns;
+  m.data = std::move(bytes);
+  if (Status s = mcap_->write(m); !s) {
+    note_error(s.error().to_string());
+    stop();
+    return;
+  }
+  received_.fetch_add(1);
+}
+
 void TopicApp::open_record_output() {
   const std::string& out = options_.out;
+  if (ends_with(out, ".mcap")) {
+    mcap_ = value_or_throw(io::McapWriter::create(out), kExitRuntime);
+    return;
+  }
   if (solutions_ && ends_with(out, ".pos")) {
     pos_ = value_or_throw(io::PosWriter::create(out, {io::PosCoordinates::Llh,
                                                       io::PosTimeFormat::WeekTow,
@@ -118,6 +217,10 @@ void TopicApp::open_record_output() {
 }
 
 void TopicApp::create_readers() {
+  if (mcap_) {
+    create_mcap_readers();
+    return;
+  }
   const std::string& topic = options_.topic;
   if (options_.tool == TopicTool::Monitor) {
     add_reader<SolutionReader>(options_.solution_topic, profile::kSolutionReader, &TopicApp::on_solution);
@@ -298,6 +401,9 @@ void TopicApp::close_outputs() {
     raw_.close();
     if (!raw_) note_error("cannot write " + options_.out);
   }
+  if (mcap_) {
+    if (auto c = mcap_->close(); !c) note_error(c.error().to_string());
+  }
 }
 
 int TopicApp::run() {
@@ -306,8 +412,10 @@ int TopicApp::run() {
   if (options_.tool == TopicTool::Monitor) report();
   close_outputs();
   if (options_.tool == TopicTool::Record) {
+    std::string topics = options_.topic;
+    for (const std::string& t : options_.more_topics) topics += ", " + t;
     std::fprintf(stderr, "canyon record: %lld samples of %s to %s%s\n", static_cast<long long>(received_.load()),
-                 options_.topic.c_str(), options_.out.c_str(),
+                 topics.c_str(), options_.out.c_str(),
                  bad_ > 0 ? (" (" + std::to_string(bad_) + " malformed, skipped)").c_str() : "");
   }
   if (!error_.empty()) {

@@ -16,7 +16,6 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -33,45 +32,15 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
-#include <fastdds/dds/topic/TopicDataType.hpp>
 
 #include "canyon/dds/dds.hpp"
 #include "canyon/dds/profiles.hpp"
+#include "canyon/dds/raw_samples.hpp"
 
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using Bytes = std::vector<std::uint8_t>;
-using eprosima::fastrtps::rtps::SerializedPayload_t;
-
-/// A type whose samples are their serialized bytes: the payload is copied in and out as it is.
-class RawType final : public fdds::TopicDataType {
- public:
-  explicit RawType(const std::string& name) {
-    setName(name.c_str());
-    m_typeSize = 1U << 20U;
-    m_isGetKeyDefined = false;
-  }
-  bool serialize(void* data, SerializedPayload_t* payload) override {
-    const auto& bytes = *static_cast<Bytes*>(data);
-    if (bytes.size() > payload->max_size) return false;
-    std::memcpy(payload->data, bytes.data(), bytes.size());
-    payload->length = static_cast<std::uint32_t>(bytes.size());
-    return true;
-  }
-  bool deserialize(SerializedPayload_t* payload, void* data) override {
-    static_cast<Bytes*>(data)->assign(payload->data, payload->data + payload->length);
-    return true;
-  }
-  std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
-    return [data] { return static_cast<std::uint32_t>(static_cast<Bytes*>(data)->size()); };
-  }
-  void* createData() override { return new Bytes(); }
-  void deleteData(void* data) override { delete static_cast<Bytes*>(data); }
-  bool getKey(void* /*data*/, eprosima::fastrtps::rtps::InstanceHandle_t* /*handle*/, bool /*force_md5*/) override {
-    return false;
-  }
-};
+using Bytes = canyon::dds::RawSample;
 
 struct Args {
   std::string mode, topic, type, qos = "sensor", file;
@@ -146,7 +115,7 @@ int run(const Args& a) {
   if (!profiles) throw std::runtime_error(profiles.error().to_string());
   auto participant = canyon::dds::DdsParticipant::create(a.domain, canyon::dds::profile::kParticipant);
   if (!participant) throw std::runtime_error(participant.error().to_string());
-  auto topic = (*participant)->topic(a.topic, fdds::TypeSupport(new RawType(a.type)));
+  auto topic = (*participant)->topic(a.topic, fdds::TypeSupport(new canyon::dds::RawSampleType(a.type)));
   if (!topic) throw std::runtime_error(topic.error().to_string());
   fdds::DomainParticipant* p = (*participant)->get();
   const bool sensor = a.qos == "sensor";

@@ -3,6 +3,8 @@
 # DiagnosticArray on ROS 2's names (rt/canyon/fix, rt/canyon/odometry, rt/diagnostics) and type names; canyon_ros2_raw
 # takes the samples off the wire as raw bytes (no canyon IDL) with ROS 2's QoS profiles; wire_check.mjs decodes them
 # with independent ROS 2 decoders driven by the upstream .msg definitions and compares each with the rover's .pos.
+# canyon record writes the same session, every topic the rover publishes, to MCAP; mcap_check.mjs reads it with the
+# MCAP and OMG IDL packages of the npm registry, decodes every message and compares the solutions with the .pos.
 # Usage: tests/ros2/wire_check.sh BUILD_DIR
 # Exit 0 pass, 1 fail, 77 (SKIP:) no npm or the npm registry unreachable for the decoders.
 set -euo pipefail
@@ -17,7 +19,7 @@ command -v npm > /dev/null || { echo "SKIP: npm not found (scripts/setup.sh inst
 # The decoders, locked, into the build folder (never the source tree); install scripts are not run.
 decoders=$build/ros2-decoders
 mkdir -p "$decoders"
-cp "$here/package.json" "$here/package-lock.json" "$here/wire_check.mjs" "$here/encode_odometry.mjs" "$decoders/"
+cp "$here/package.json" "$here/package-lock.json" "$here"/*.mjs "$decoders/"
 if [[ ! -f $decoders/node_modules/.package-lock.json || $here/package-lock.json -nt $decoders/node_modules/.package-lock.json ]]; then
   (cd "$decoders" && npm ci --no-audit --no-fund --ignore-scripts --loglevel=error) ||
     { echo "SKIP: npm ci failed for the ROS 2 decoders (is the npm registry reachable?)"; exit 77; }
@@ -55,10 +57,32 @@ record() {  # topic type qos file count (0: until 5 s without a sample)
 record rt/canyon/fix sensor_msgs::msg::dds_::NavSatFix_ sensor fix.bin "$epochs"
 record rt/canyon/odometry nav_msgs::msg::dds_::Odometry_ sensor odom.bin 0  # from the first fix on
 record rt/diagnostics diagnostic_msgs::msg::dds_::DiagnosticArray_ default diag.bin "$epochs"
-"$canyon" rover --config "$tmp/rover.yaml" -q --wait-for-subscribers 3 --wait-timeout 30
+# The same session recorded to MCAP: every topic the rover publishes, read back below by the independent reader.
+session_topics=(canyon/solution canyon/timing canyon/prior canyon/float canyon/bridged canyon/alignment rt/canyon/fix
+                rt/canyon/odometry rt/diagnostics)
+"$canyon" record "${session_topics[@]}" --out "$tmp/session.mcap" --domain "$domain" 2> "$tmp/mcap.log" &
+mcap_pid=$!
+sleep 2  # every reader of the recorder discovered (the rover waits for the solution and ROS 2 ones only)
+"$canyon" rover --config "$tmp/rover.yaml" -q --wait-for-subscribers 7 --wait-timeout 30
 for p in "${pids[@]}"; do wait "$p" || { echo "FAIL: a recorder missed samples: $(cat "$tmp"/*.log)"; exit 1; }; done
 cat "$tmp"/*.bin.log
 node "$decoders/wire_check.mjs" "$tmp"
+wait "$mcap_pid" || { echo "FAIL: canyon record to MCAP: $(cat "$tmp/mcap.log")"; exit 1; }
+cat "$tmp/mcap.log"
+node "$decoders/mcap_check.mjs" "$tmp/session.mcap" "$tmp/rover.pos" "$epochs" "${session_topics[@]}"
+# Bad input to canyon record: a topic it has no schema for, several topics without MCAP, an MCAP path that cannot be
+# written: each a clear error, nothing started.
+expect_error() {  # exit-code message args...
+  local code=$1 message=$2 rc=0
+  shift 2
+  "$canyon" record "$@" --domain "$domain" > "$tmp/err.log" 2>&1 || rc=$?
+  [[ $rc -eq $code ]] && grep -qF "$message" "$tmp/err.log" ||
+    { echo "FAIL: canyon record $*: exit $rc, $(cat "$tmp/err.log") (expected $code, '$message')"; exit 1; }
+}
+expect_error 2 "unknown topic 'foo/bar'" canyon/solution foo/bar --out "$tmp/x.mcap"
+expect_error 2 "several topics need a recording to .mcap" canyon/solution canyon/timing --out "$tmp/x.csv"
+expect_error 1 "/dev/null/x.mcap: cannot create the MCAP file" canyon/solution --out /dev/null/x.mcap --duration 1
+echo "canyon record bad input: unknown topic, several topics without MCAP, unwritable MCAP path: named"
 
 # VIO in: Odometry -> canyon rover equals the same poses from a file (vio_gps.csv: the poses on GPST, no
 # cross-covariances, as Odometry carries none).

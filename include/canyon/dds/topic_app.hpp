@@ -4,6 +4,8 @@
 //   record TOPIC --out FILE: canyon/solution to .pos (RTKLIB format), .nmea (GGA) or .csv (every sample, status 0
 //     too, with its sequence number and arrival time); canyon/rtcm to the raw RTCM 3 stream; canyon/timing and the
 //     stage outputs to CSV or text lines; canyon/vio and canyon/timesync to replayable vio.csv and timesync.csv.
+//   record TOPIC... --out SESSION.mcap: every sample of every topic as it came off the wire (CDR), with its type's OMG
+//     IDL as the channel's schema (io/mcap.hpp, dds/raw_samples.hpp), for Foxglove, the mcap tools and canyon play.
 //   echo TOPIC: one line per sample on stdout.
 //   monitor: latency percentiles, correction age, queues, drops and the solution of the solution and timing topics,
 //     refreshed on the terminal or as JSON lines, and with http_port the live dashboard.
@@ -22,8 +24,10 @@
 
 #include "canyon/dds/app.hpp"
 #include "canyon/dds/dds.hpp"
+#include "canyon/dds/raw_samples.hpp"
 #include "canyon/dds/rover_msgs.hpp"
 #include "canyon/dds/rtcm_frame.hpp"
+#include "canyon/io/mcap.hpp"
 #include "canyon/io/nmea.hpp"
 #include "canyon/io/pos_file.hpp"
 #include "canyon/pipeline/monitor_model.hpp"
@@ -41,7 +45,8 @@ enum class TopicTool { Record, Echo, Monitor };
 struct TopicOptions {
   TopicTool tool = TopicTool::Echo;
   std::string topic;                               ///< record, echo: canyon/solution, canyon/rtcm, ... (by suffix)
-  std::string out;                                 ///< record: .pos, .nmea, .csv, .rtcm3 or any other text file
+  std::vector<std::string> more_topics;            ///< record to .mcap: the other topics of the session
+  std::string out;                                 ///< record: .pos, .nmea, .csv, .rtcm3, .mcap or another text file
   int domain = 0;                                  ///< DDS domain id
   std::string profiles;                            ///< deployment profile file on top of the shipped QoS; "": none
   std::int64_t count = 0;                          ///< stop after this many samples; 0: no limit
@@ -79,6 +84,11 @@ class TopicApp {
 
  private:
   struct AnyReader;
+  struct McapReader;
+  /// record to .mcap: a raw reader, a schema and a channel per topic.
+  void create_mcap_readers();
+  [[nodiscard]] std::vector<std::string> mcap_topics() const;
+  void on_mcap_sample(std::uint16_t channel, RawSample&& bytes, std::uint64_t publish_time_ns);
   void start_dashboard();
   void open_record_output();
   void create_readers();
@@ -115,6 +125,8 @@ class TopicApp {
   std::optional<io::PosWriter> pos_;
   std::optional<io::NmeaWriter> nmea_;
   std::ofstream raw_;
+  std::optional<io::McapWriter> mcap_;
+  std::vector<std::uint32_t> mcap_sequence_;  ///< per channel
   pipeline::MonitorModel model_;
   std::vector<std::unique_ptr<AnyReader>> readers_;  ///< last: deleted first, so no callback runs after
   std::atomic<bool> stop_{false};

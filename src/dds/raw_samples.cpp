@@ -1,0 +1,94 @@
+// DDS samples as the bytes on the wire (see raw_samples.hpp).
+
+#include "canyon/dds/raw_samples.hpp"
+
+#include <cstring>
+#include <utility>
+
+#include "canyon/dds/profiles.hpp"
+
+namespace canyon::dds {
+namespace {
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+/// canyon's own types: every canyon IDL file, so that a type's schema holds the types it uses.
+std::string canyon_schema() {
+  return msgs::idl_text("GnssObservation.idl") + "\n" + msgs::idl_text("RtcmFrame.idl") + "\n" +
+         msgs::idl_text("RoverPipeline.idl");
+}
+
+}  // namespace
+
+RawSampleType::RawSampleType(const std::string& type_name) {
+  setName(type_name.c_str());
+  m_typeSize = 1U << 20U;  // the largest payload (RTCM frames, DiagnosticArrays are far smaller)
+  m_isGetKeyDefined = false;
+}
+
+bool RawSampleType::serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) {
+  const auto& bytes = *static_cast<RawSample*>(data);
+  if (bytes.size() > payload->max_size) return false;
+  std::memcpy(payload->data, bytes.data(), bytes.size());
+  payload->length = static_cast<std::uint32_t>(bytes.size());
+  return true;
+}
+
+bool RawSampleType::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) {
+  static_cast<RawSample*>(data)->assign(payload->data, payload->data + payload->length);
+  return true;
+}
+
+std::function<std::uint32_t()> RawSampleType::getSerializedSizeProvider(void* data) {
+  return [data] { return static_cast<std::uint32_t>(static_cast<RawSample*>(data)->size()); };
+}
+
+void* RawSampleType::createData() {
+  return new RawSample();
+}
+
+void RawSampleType::deleteData(void* data) {
+  delete static_cast<RawSample*>(data);
+}
+
+bool RawSampleType::getKey(void* /*data*/, eprosima::fastrtps::rtps::InstanceHandle_t* /*handle*/, bool /*force_md5*/) {
+  return false;
+}
+
+std::optional<RecordedTopic> recorded_topic(const std::string& topic) {
+  struct Known {
+    const char* suffix;
+    const char* type;
+    const char* profile;
+  };
+  static const Known kCanyon[] = {
+      {"solution", "canyon::msg::Solution", profile::kSolutionReader},
+      {"timing", "canyon::msg::StageTiming", profile::kTimingReader},
+      {"rtcm", "canyon::msg::RtcmFrame", profile::kRtcmReader},
+      {"bridged", "canyon::msg::BridgedEpoch", profile::kStageReader},
+      {"prior", "canyon::msg::Prior", profile::kStageReader},
+      {"float", "canyon::msg::FloatSolution", profile::kStageReader},
+      {"alignment", "canyon::msg::Alignment", profile::kStageReader},
+      {"vio", "canyon::msg::VioPose", profile::kVioReader},
+      {"timesync", "canyon::msg::TimeSyncSample", profile::kVioReader},
+  };
+  static const Known kRos2[] = {
+      {"fix", "sensor_msgs::msg::dds_::NavSatFix_", profile::kRos2SensorDataReader},
+      {"odometry", "nav_msgs::msg::dds_::Odometry_", profile::kRos2SensorDataReader},
+      {"diagnostics", "diagnostic_msgs::msg::dds_::DiagnosticArray_", profile::kRos2DefaultReader},
+  };
+  if (topic.rfind("rt/", 0) == 0) {
+    for (const Known& k : kRos2) {
+      if (ends_with(topic, k.suffix)) return RecordedTopic{k.type, msgs::idl_text("Ros2Messages.idl"), k.profile};
+    }
+    return std::nullopt;
+  }
+  for (const Known& k : kCanyon) {
+    if (ends_with(topic, k.suffix)) return RecordedTopic{k.type, canyon_schema(), k.profile};
+  }
+  return std::nullopt;
+}
+
+}  // namespace canyon::dds
