@@ -679,10 +679,12 @@ int run_main(int argc, char** argv) {
   app.add_subcommand("vio", "Publish VIO poses and time-sync pairs from files on DDS, as a VIO node (runs canyon-vio)")
       ->allow_extras();
   app.add_subcommand("record",
-                     "Record a DDS topic to a file: solutions to .pos/NMEA/CSV, others to a replayable log "
-                     "(runs canyon-record)")
+                     "Record a DDS topic to a file: solutions to .pos/NMEA/CSV, others to a replayable log; any "
+                     "set of topics to MCAP (runs canyon-record)")
       ->allow_extras();
   app.add_subcommand("echo", "Print the samples of a DDS topic (runs canyon-echo)")->allow_extras();
+  app.add_subcommand("play", "Publish an MCAP session recorded by canyon record on DDS again (runs canyon-play)")
+      ->allow_extras();
   app.add_subcommand("monitor",
                      "Stage and end-to-end latency, correction age, queues, drops, solution (runs "
                      "canyon-monitor)")
@@ -736,7 +738,7 @@ int exec_dds_command(const std::string& command, int argc, char** argv) {
 int main(int argc, char** argv) {
   if (argc >= 2) {
     const std::string command = argv[1];
-    for (const char* dds : {"base", "rover", "vio", "record", "echo", "monitor"}) {
+    for (const char* dds : {"base", "rover", "vio", "record", "echo", "monitor", "play"}) {
       if (command == dds) return exec_dds_command(command, argc, argv);
     }
   }

@@ -62,31 +62,34 @@ std::optional<RecordedTopic> recorded_topic(const std::string& topic) {
     const char* suffix;
     const char* type;
     const char* profile;
+    const char* writer;
   };
   static const Known kCanyon[] = {
-      {"solution", "canyon::msg::Solution", profile::kSolutionReader},
-      {"timing", "canyon::msg::StageTiming", profile::kTimingReader},
-      {"rtcm", "canyon::msg::RtcmFrame", profile::kRtcmReader},
-      {"bridged", "canyon::msg::BridgedEpoch", profile::kStageReader},
-      {"prior", "canyon::msg::Prior", profile::kStageReader},
-      {"float", "canyon::msg::FloatSolution", profile::kStageReader},
-      {"alignment", "canyon::msg::Alignment", profile::kStageReader},
-      {"vio", "canyon::msg::VioPose", profile::kVioReader},
-      {"timesync", "canyon::msg::TimeSyncSample", profile::kVioReader},
+      {"solution", "canyon::msg::Solution", profile::kSolutionReader, profile::kSolutionWriter},
+      {"timing", "canyon::msg::StageTiming", profile::kTimingReader, profile::kTimingWriter},
+      {"rtcm", "canyon::msg::RtcmFrame", profile::kRtcmReader, profile::kRtcmWriter},
+      {"bridged", "canyon::msg::BridgedEpoch", profile::kStageReader, profile::kStageWriter},
+      {"prior", "canyon::msg::Prior", profile::kStageReader, profile::kStageWriter},
+      {"float", "canyon::msg::FloatSolution", profile::kStageReader, profile::kStageWriter},
+      {"alignment", "canyon::msg::Alignment", profile::kStageReader, profile::kStageWriter},
+      {"vio", "canyon::msg::VioPose", profile::kVioReader, profile::kVioWriter},
+      {"timesync", "canyon::msg::TimeSyncSample", profile::kVioReader, profile::kVioWriter},
   };
   static const Known kRos2[] = {
-      {"fix", "sensor_msgs::msg::dds_::NavSatFix_", profile::kRos2SensorDataReader},
-      {"odometry", "nav_msgs::msg::dds_::Odometry_", profile::kRos2SensorDataReader},
-      {"diagnostics", "diagnostic_msgs::msg::dds_::DiagnosticArray_", profile::kRos2DefaultReader},
+      {"fix", "sensor_msgs::msg::dds_::NavSatFix_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
+      {"odometry", "nav_msgs::msg::dds_::Odometry_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
+      {"diagnostics", "diagnostic_msgs::msg::dds_::DiagnosticArray_", profile::kRos2DefaultReader,
+       profile::kRos2DefaultWriter},
   };
   if (topic.rfind("rt/", 0) == 0) {
     for (const Known& k : kRos2) {
-      if (ends_with(topic, k.suffix)) return RecordedTopic{k.type, msgs::idl_text("Ros2Messages.idl"), k.profile};
+      if (ends_with(topic, k.suffix))
+        return RecordedTopic{k.type, msgs::idl_text("Ros2Messages.idl"), k.profile, k.writer};
     }
     return std::nullopt;
   }
   for (const Known& k : kCanyon) {
-    if (ends_with(topic, k.suffix)) return RecordedTopic{k.type, canyon_schema(), k.profile};
+    if (ends_with(topic, k.suffix)) return RecordedTopic{k.type, canyon_schema(), k.profile, k.writer};
   }
   return std::nullopt;
 }

@@ -84,6 +84,31 @@ expect_error 2 "several topics need a recording to .mcap" canyon/solution canyon
 expect_error 1 "/dev/null/x.mcap: cannot create the MCAP file" canyon/solution --out /dev/null/x.mcap --duration 1
 echo "canyon record bad input: unknown topic, several topics without MCAP, unwritable MCAP path: named"
 
+# canyon play: the session published again and recorded again equals it byte for byte (read by @mcap/core).
+"$canyon" record "${session_topics[@]}" --out "$tmp/replayed.mcap" --domain "$domain" 2> "$tmp/replay.log" &
+replay_pid=$!
+sleep 2
+"$canyon" play "$tmp/session.mcap" --pace 5 --domain "$domain" --wait-for-readers 1 -q
+wait "$replay_pid"
+node "$decoders/mcap_same.mjs" "$tmp/session.mcap" "$tmp/replayed.mcap"
+# Bad input to canyon play: a file another writer (@mcap/core) made with a channel of a type canyon does not know
+# plays the rest, naming the channel; a file cut short plays what came before the cut, naming the byte; not an MCAP
+# file is an error.
+node "$decoders/mcap_foreign.mjs" "$tmp/session.mcap" "$tmp/foreign.mcap"
+"$canyon" play "$tmp/foreign.mcap" --pace 0 --domain "$domain" --linger 0 > "$tmp/foreign.log" 2>&1
+grep -qF "channel 1 ('foo/bar', schema 'foo::msg::Bar') is not one canyon knows: left out" "$tmp/foreign.log" &&
+  grep -qF "canyon/solution: $epochs messages played" "$tmp/foreign.log" ||
+  { echo "FAIL: canyon play of a foreign channel:"; cat "$tmp/foreign.log"; exit 1; }
+head -c $(($(stat -c %s "$tmp/session.mcap") / 2)) "$tmp/session.mcap" > "$tmp/cut.mcap"
+"$canyon" play "$tmp/cut.mcap" --pace 0 --domain "$domain" --linger 0 > "$tmp/cut.log" 2>&1
+grep -q "cut.mcap: cut short at byte [0-9]* (.*); playing the [0-9]* messages before it" "$tmp/cut.log" ||
+  { echo "FAIL: canyon play of a cut file:"; cat "$tmp/cut.log"; exit 1; }
+rc=0
+"$canyon" play "$tmp/rover.pos" --domain "$domain" > "$tmp/notmcap.log" 2>&1 || rc=$?
+[[ $rc -eq 1 ]] && grep -qF "not an MCAP file" "$tmp/notmcap.log" ||
+  { echo "FAIL: canyon play of a .pos: exit $rc, $(cat "$tmp/notmcap.log")"; exit 1; }
+echo "canyon play bad input: a foreign channel left out and named, a cut file played up to the cut, a .pos refused"
+
 # VIO in: Odometry -> canyon rover equals the same poses from a file (vio_gps.csv: the poses on GPST, no
 # cross-covariances, as Odometry carries none).
 node "$decoders/encode_odometry.mjs" "$tmp/sim/vio.csv" "$tmp/sim/timesync.csv" "$tmp"

@@ -37,6 +37,7 @@ struct RecordedTopic {
   std::string type_name;  ///< e.g. "canyon::msg::Solution"
   std::string schema;     ///< OMG IDL text defining it (with the types it uses)
   const char* reader_profile = nullptr;
+  const char* writer_profile = nullptr;  ///< canyon play publishes it with the profile of its original writer
 };
 
 /// What recording `topic` takes (by its suffix, as canyon record and echo tell topics apart; "rt/..." topics: the
