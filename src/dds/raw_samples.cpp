@@ -24,7 +24,7 @@ std::string canyon_schema() {
 
 RawSampleType::RawSampleType(const std::string& type_name) {
   setName(type_name.c_str());
-  m_typeSize = 1U << 20U;  // the largest payload (RTCM frames, DiagnosticArrays are far smaller)
+  m_typeSize = 1U << 16U;  // the largest payload canyon publishes is a few kB (Fast DDS preallocates this per sample)
   m_isGetKeyDefined = false;
 }
 

@@ -4,7 +4,7 @@
 # into one MCAP file and, beside it, one `canyon record` per canyon topic writes canyon's own files (.csv for the
 # solutions and the timing, text lines for the stage outputs; the ROS 2 topics have no own format and are left out
 # of the size comparison). Prints the CPU seconds of the rover and of the MCAP recorder (their ratio: the
-# recorder's share of the rover's CPU), and the MCAP file's size against the canyon topics' own files (and the MCAP
+# recorder's share of the rover's CPU; and the own-file recorders' CPU beside it), and the MCAP file's size against the canyon topics' own files (and the MCAP
 # size of those topics alone, from its channel byte counts).
 # Usage: tests/bench/mcap_cost.sh [BUILD_DIR] [DURATION_S]   (defaults: build, 120)
 set -euo pipefail
@@ -39,7 +39,8 @@ TIMEFORMAT='%3U %3S'
     --domain "$domain" 2> "$tmp/mcap.log"; } 2> "$tmp/mcap.cpu" &
 pids+=($!)
 for k in "${!canyon_topics[@]}"; do
-  "$canyon" record "${canyon_topics[$k]}" --out "$tmp/own/${own_out[$k]}" --domain "$domain" 2> "$tmp/own_$k.log" &
+  { time "$canyon" record "${canyon_topics[$k]}" --out "$tmp/own/${own_out[$k]}" --domain "$domain" \
+      2> "$tmp/own_$k.log"; } 2> "$tmp/own_$k.cpu" &
   pids+=($!)
 done
 mkdir -p "$tmp/own"
@@ -49,12 +50,14 @@ for p in "${pids[@]}"; do wait "$p"; done
 cpu() { awk '{printf "%.2f", $1 + $2}' "$1"; }
 rover_cpu=$(cpu "$tmp/rover.cpu")
 mcap_cpu=$(cpu "$tmp/mcap.cpu")
+own_cpu=$(cat "$tmp"/own_*.cpu | awk '{s += $1 + $2} END {printf "%.2f", s}')
 own_bytes=$(cat "$tmp"/own/* | wc -c)
 mcap_bytes=$(stat -c %s "$tmp/session.mcap")
 cat "$tmp/mcap.log"
-python3 - "$tmp/session.mcap" "$rover_cpu" "$mcap_cpu" "$own_bytes" "$mcap_bytes" "$duration" << 'PY'
+python3 - "$tmp/session.mcap" "$rover_cpu" "$mcap_cpu" "$own_bytes" "$mcap_bytes" "$duration" "$own_cpu" << 'PY'
 import struct, sys
 path, rover_cpu, mcap_cpu, own, total, duration = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]), sys.argv[6]
+own_cpu = float(sys.argv[7])
 data = open(path, "rb").read()
 at, topics, per_channel = 8, {}, {}
 while at + 9 <= len(data):
@@ -70,8 +73,9 @@ while at + 9 <= len(data):
         break
     at += 9 + n
 canyon_bytes = sum(b for cid, b in per_channel.items() if not topics[cid].startswith("rt/"))
-print("duration %s s at 5 Hz: rover CPU %.2f s, MCAP recorder CPU %.2f s = %.1f %% of the rover's" %
-      (duration, rover_cpu, mcap_cpu, 100.0 * mcap_cpu / rover_cpu))
+print("duration %s s at 5 Hz: rover CPU %.2f s, MCAP recorder CPU %.2f s = %.1f %% of the rover's; the six "
+      "recorders of canyon's own files %.2f s together (6 of the 9 topics)" %
+      (duration, rover_cpu, mcap_cpu, 100.0 * mcap_cpu / rover_cpu, own_cpu))
 print("MCAP file %d bytes (all 9 topics); the 6 canyon topics' messages in it %d bytes against their own files %d "
       "bytes: %.2fx" % (total, canyon_bytes, own, canyon_bytes / own))
 PY
