@@ -124,7 +124,7 @@ void RoverOutputs::take_solved_ros2(const pipeline::SolvedEpoch& item) {
   auto fix = to_navsatfix(item.epoch().rover.time, solution, navsat_service(item.epoch().rover), ros2_, leaps_);
   if (!ros2_fix_->write(fix)) refused_.fetch_add(1);
   const bool gnss = fix.status().status() >= sensor_msgs::msg::NavSatStatus_Constants::STATUS_FIX;
-  if (!enu_origin_ && gnss) enu_origin_ = core::ecef_to_geodetic(solution->p_E_m);
+  if (!enu_origin_ && gnss && solution != nullptr) enu_origin_ = core::ecef_to_geodetic(solution->p_E_m);
   if (solution != nullptr && enu_origin_) odometry_pending_ = to_odometry(*solution, *enu_origin_, ros2_, leaps_);
   diagnostics_pending_ = to_diagnostics(*timing_pending_, solution, leaps_);
 }
