@@ -63,13 +63,6 @@ OutputPaths output_paths(const EvaluateConfig& c) {
   return out;
 }
 
-Status write_text(const std::string& path, const std::string& text, const std::string& what) {
-  auto file = io::TextFileWriter::create(path, what);
-  if (!file) return file.error();
-  if (Status s = file->write_line(text, ""); !s) return s;
-  return file->close();
-}
-
 /// The KML and GPX tracks of the evaluated solutions with the truth; an error lists what was written before it.
 Status write_map_tracks(const EvaluateConfig& config, const eval::EvaluationReport& report, const eval::Truth& truth,
                         std::vector<std::string>& written) {
@@ -159,14 +152,16 @@ Result<EvaluateSummary> run_evaluate(const EvaluateConfig& config) {
     summary.written.push_back(path);
     return Ok{};
   };
-  if (Status s =
-          write(out.markdown,
-                [&](const std::string& p) { return write_text(p, eval::format_markdown(*report), "Markdown file"); });
+  if (Status s = write(out.markdown,
+                       [&](const std::string& p) {
+                         return io::write_text_file(p, eval::format_markdown(*report), "Markdown file");
+                       });
       !s) {
     return s.error();
   }
   if (Status s =
-          write(out.json, [&](const std::string& p) { return write_text(p, eval::format_json(*report), "JSON file"); });
+          write(out.json,
+                [&](const std::string& p) { return io::write_text_file(p, eval::format_json(*report), "JSON file"); });
       !s) {
     return s.error();
   }

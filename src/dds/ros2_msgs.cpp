@@ -19,6 +19,7 @@ namespace dm = diagnostic_msgs::msg;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::int64_t kGpsEpochPosixS = 315964800;  // 1980-01-06 00:00:00 UTC
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr const char* kStageNames[6] = {"ingest", "time_bridge", "alignment", "prediction", "update", "ambiguity"};
 
@@ -37,6 +38,14 @@ void put_row_major(const Eigen::Matrix<double, N, N>& m, Array& out) {
   for (int r = 0; r < N; ++r) {
     for (int c = 0; c < N; ++c) out[k++] = m(r, c);
   }
+}
+
+/// diag(R, R): turns a pose covariance over (position, rotation) by R.
+Matrix6d block_rotation(const Eigen::Matrix3d& R) {
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = R;
+  J.bottomRightCorner<3, 3>() = R;
+  return J;
 }
 
 dm::dds_::KeyValue_ key_value(const std::string& key, const std::string& value) {
@@ -60,7 +69,6 @@ std::string ros2_dds_topic(const std::string& ros_topic) {
 }
 
 builtin_interfaces::msg::dds_::Time_ ros_time(const core::GpsTime& t, const core::LeapSecondTable& leaps) {
-  constexpr std::int64_t kGpsEpochPosixS = 315964800;  // 1980-01-06 00:00:00 UTC
   const double whole_tow = std::floor(t.tow_s);
   auto nanos = static_cast<std::int64_t>(std::llround((t.tow_s - whole_tow) * 1e9));
   std::int64_t seconds = kGpsEpochPosixS + static_cast<std::int64_t>(t.week) * core::kSecondsPerWeek +
@@ -147,9 +155,7 @@ nav_msgs::msg::dds_::Odometry_ to_odometry(const core::Solution& solution, const
 }
 
 core::Matrix6d ros2_pose_covariance(const core::Matrix6d& xi_covariance, const core::Pose& T_OI) {
-  Matrix6d J = Matrix6d::Zero();
-  J.topLeftCorner<3, 3>() = T_OI.rotation();
-  J.bottomRightCorner<3, 3>() = T_OI.rotation();
+  const Matrix6d J = block_rotation(T_OI.rotation());
   return J * xi_covariance * J.transpose();
 }
 
@@ -174,7 +180,6 @@ Result<io::VioRecord> from_ros2_odometry(const nav_msgs::msg::dds_::Odometry_& o
     return Error{which + ": a value of the pose or its covariance is not finite"};
   }
   io::VioRecord r;
-  constexpr std::int64_t kGpsEpochPosixS = 315964800;
   const std::int64_t posix_s = stamp.sec();
   // GPST - UTC at this instant: the table is keyed by GPST, one leap second apart at most near a step.
   const core::GpsTime approx{static_cast<int>((posix_s - kGpsEpochPosixS) / core::kSecondsPerWeek),
@@ -191,9 +196,7 @@ Result<io::VioRecord> from_ros2_odometry(const nav_msgs::msg::dds_::Odometry_& o
   for (int row = 0; row < 6; ++row) {
     for (int col = 0; col < 6; ++col) C_ros(row, col) = covariance[static_cast<std::size_t>(row) * 6 + col];
   }
-  Matrix6d J = Matrix6d::Zero();
-  J.topLeftCorner<3, 3>() = r.T_OI.rotation().transpose();
-  J.bottomRightCorner<3, 3>() = r.T_OI.rotation().transpose();
+  const Matrix6d J = block_rotation(r.T_OI.rotation().transpose());
   r.covariance = J * (0.5 * (C_ros + C_ros.transpose())) * J.transpose();
   if (Eigen::LLT<core::Matrix6d>(r.covariance).info() != Eigen::Success) {
     return Error{which + ": the pose covariance is not positive definite"};

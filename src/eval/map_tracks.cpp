@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "canyon/core/geodesy.hpp"
+#include "canyon/eval/svg.hpp"
 #include "canyon/io/text_file_writer.hpp"
 
 namespace canyon::eval {
@@ -40,21 +41,6 @@ std::string utc_text(const core::GpsTime& t, const core::LeapSecondTable& leaps)
   std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", c.year, c.month, c.day, c.hour, c.minute,
                 static_cast<int>(std::lround(c.second)), static_cast<int>(ms % 1000));
   return text;
-}
-
-/// Characters that XML text and attributes cannot hold as they are.
-std::string xml_escaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 /// The KML style id of a status and its colour (aabbggrr).
@@ -95,14 +81,14 @@ void append_kml_styles(std::string& out) {
 
 void append_kml_line(std::string& out, const std::string& name, const char* style,
                      const std::vector<std::string>& coordinates) {
-  out += "<Placemark><name>" + xml_escaped(name) + "</name><styleUrl>#" + style +
+  out += "<Placemark><name>" + xml_escape(name) + "</name><styleUrl>#" + style +
          "</styleUrl><LineString><tessellate>1</tessellate><coordinates>";
   for (std::size_t k = 0; k < coordinates.size(); ++k) out += (k == 0 ? "" : " ") + coordinates[k];
   out += "</coordinates></LineString></Placemark>\n";
 }
 
 void append_kml_track(std::string& out, const MapTrack& track, const core::LeapSecondTable& leaps) {
-  out += "<Folder><name>" + xml_escaped(track.name) + "</name>\n";
+  out += "<Folder><name>" + xml_escape(track.name) + "</name>\n";
   std::vector<std::string> line;
   for (const core::Solution& s : track.solutions) {
     if (s.status == core::SolutionStatus::None) continue;
@@ -159,7 +145,7 @@ void append_gpx_status_track(std::string& out, const MapTrack& track, core::Solu
   if (body.empty()) return;
   const std::string name = map_status_name(status);
   out +=
-      "<trk><name>" + xml_escaped(track.name) + ": " + name + "</name><type>" + name + "</type>\n" + body + "</trk>\n";
+      "<trk><name>" + xml_escape(track.name) + ": " + name + "</name><type>" + name + "</type>\n" + body + "</trk>\n";
 }
 
 }  // namespace
@@ -213,23 +199,12 @@ std::string format_gpx(const MapTracks& tracks, const core::LeapSecondTable& lea
   return out + "</gpx>\n";
 }
 
-namespace {
-
-Status write_document(const std::string& path, const std::string& text, const std::string& what) {
-  auto file = io::TextFileWriter::create(path, what);
-  if (!file) return file.error();
-  if (Status s = file->write_line(text, ""); !s) return s;
-  return file->close();
-}
-
-}  // namespace
-
 Status write_kml(const std::string& path, const MapTracks& tracks) {
-  return write_document(path, format_kml(tracks, core::builtin_leap_seconds()), "KML file");
+  return io::write_text_file(path, format_kml(tracks, core::builtin_leap_seconds()), "KML file");
 }
 
 Status write_gpx(const std::string& path, const MapTracks& tracks) {
-  return write_document(path, format_gpx(tracks, core::builtin_leap_seconds()), "GPX file");
+  return io::write_text_file(path, format_gpx(tracks, core::builtin_leap_seconds()), "GPX file");
 }
 
 }  // namespace canyon::eval

@@ -137,11 +137,7 @@ std::string SvgDocument::str() const {
 }
 
 Status SvgDocument::write(const std::string& path) const {
-  auto file = io::TextFileWriter::create(path, "SVG file");
-  if (!file) return file.error();
-  const std::string text = str();
-  if (Status s = file->write_line(text, ""); !s) return s;
-  return file->close();
+  return io::write_text_file(path, str(), "SVG file");
 }
 
 }  // namespace canyon::eval

@@ -37,4 +37,11 @@ Status TextFileWriter::close() {
   return Ok{};
 }
 
+Status write_text_file(const std::string& path, const std::string& text, std::string what) {
+  auto file = TextFileWriter::create(path, std::move(what));
+  if (!file) return file.error();
+  if (Status s = file->write_line(text, ""); !s) return s;
+  return file->close();
+}
+
 }  // namespace canyon::io

@@ -9,17 +9,10 @@ import fs from "node:fs";
 import { McapStreamReader } from "@mcap/core";
 import { parseIDL } from "@foxglove/omgidl-parser";
 import { MessageReader } from "@foxglove/omgidl-serialization";
+import { check, failures } from "./check.mjs";
 
 const [file, posFile, epochsText, ...topics] = process.argv.slice(2);
 const epochs = Number(epochsText);
-const failures = [];
-const check = (ok, what) => {
-  if (!ok) {
-    failures.push(what);
-    console.log("FAIL: " + what);
-  }
-  return ok;
-};
 
 const reader = new McapStreamReader({ validateCrcs: true });
 reader.append(fs.readFileSync(file));

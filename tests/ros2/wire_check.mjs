@@ -10,19 +10,12 @@ import path from "node:path";
 import { createRequire } from "node:module";
 import { parse } from "@foxglove/rosmsg";
 import { MessageReader } from "@foxglove/rosmsg2-serialization";
+import { check, failures } from "./check.mjs";
 
 const require = createRequire(import.meta.url);
 const msgdefs = path.join(path.dirname(require.resolve("@foxglove/rosmsg-msgs-common/package.json")), "msgdefs",
                           "ros2humble");
 const dir = process.argv[2];
-const failures = [];
-const check = (ok, what) => {
-  if (!ok) {
-    failures.push(what);
-    console.log("FAIL: " + what);
-  }
-  return ok;
-};
 
 function reader(type) {  // "sensor_msgs/msg/NavSatFix"
   const text = fs.readFileSync(path.join(msgdefs, type + ".msg"), "utf8");

@@ -37,4 +37,7 @@ class TextFileWriter {
   std::string what_;
 };
 
+/// Writes `text` as the whole of `path` (created or truncated, its folder created); errors name the path and `what`.
+Status write_text_file(const std::string& path, const std::string& text, std::string what);
+
 }  // namespace canyon::io
