@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -13,6 +14,8 @@
 
 #include <CLI/CLI.hpp>
 #include <malloc.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "canyon/commands/check_fixes.hpp"
@@ -85,6 +88,8 @@ struct ProcessArgs {
   bool quiet = false;
   bool verbose = false;
   std::string pipeline = "bridge-ahead";
+  std::string session;      ///< process only: a recorded MCAP session whose rover inputs are processed
+  std::string session_dir;  ///< where its inputs are written (kept); empty: a temporary folder (removed)
 };
 
 /// The options of canyon process that check-fixes shares: configuration, inputs, outputs, exclusions, pipeline.
@@ -123,6 +128,13 @@ void add_process_options(CLI::App* cmd, ProcessArgs& args) {
 void add_process_command(CLI::App& app, ProcessArgs& args) {
   CLI::App* cmd = app.add_subcommand("process", "Process recorded observations into a solution file (.pos)");
   add_process_options(cmd, args);
+  cmd->add_option("--session", args.session,
+                  "A session recorded by canyon record (SESSION.mcap) as the input: the rover's epochs "
+                  "(canyon/observations), the base's RTCM 3 (canyon/rtcm) and its ephemerides unless --nav is given, "
+                  "the VIO (canyon/vio, canyon/timesync); runs canyon-play --extract")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--session-dir", args.session_dir,
+                  "--session: write the extracted inputs into this folder and keep them (default: a temporary one)");
   cmd->add_flag("--print-config", args.print_config, "Print the effective configuration as YAML and exit");
   args.describe_config =
       cmd->add_option("--describe-config", args.describe_what,
@@ -229,7 +241,66 @@ std::optional<int> build_process_config(const ProcessArgs& args, canyon::config:
   return std::nullopt;
 }
 
-int run_process_command(const ProcessArgs& args) {
+std::string sibling_program(const std::string& command);
+
+/// --session: the session's rover inputs written into `dir` by canyon-play --extract (the DDS side decodes the
+/// recorded messages), and `args` pointed at them. An exit status when that fails.
+std::optional<int> take_session_inputs(ProcessArgs& args, const std::string& dir) {
+  if (!args.rover.empty() || !args.base.empty() || !args.vio.empty() || !args.timesync.empty()) {
+    std::cerr << "canyon: error: --session gives the inputs: leave out --rover, --base, --vio and --timesync\n";
+    return kExitUsage;
+  }
+  const std::string program = sibling_program("play");
+  std::vector<std::string> words{program, "--extract", dir, args.session};
+  std::vector<char*> argv;
+  argv.reserve(words.size() + 1);
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, program.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
+    std::cerr << "canyon: error: --session runs " << program << ", which cannot be started (build canyon-play)\n";
+    return kExitUsage;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return kExitInput;
+  const auto in_dir = [&](const char* name) {
+    const std::string path = dir + "/" + name;
+    return access(path.c_str(), R_OK) == 0 ? path : std::string();
+  };
+  args.rover = in_dir("rover.obs");
+  args.base = in_dir("base.rtcm3");
+  args.vio = in_dir("vio.csv");
+  args.timesync = in_dir("timesync.csv");
+  if (args.nav.empty() && !in_dir("nav.rnx").empty()) args.nav.push_back(in_dir("nav.rnx"));
+  return std::nullopt;
+}
+
+int run_process_files(const ProcessArgs& args);
+
+int run_process_command(const ProcessArgs& given) {
+  if (given.session.empty()) return run_process_files(given);
+  ProcessArgs args = given;
+  std::string dir = args.session_dir;
+  if (dir.empty()) {
+    std::string pattern = "/tmp/canyon-session-XXXXXX";
+    if (mkdtemp(pattern.data()) == nullptr) {
+      std::cerr << "canyon: error: cannot create a temporary folder: " << std::strerror(errno) << "\n";
+      return kExitInput;
+    }
+    dir = pattern;
+  }
+  std::optional<int> failed = take_session_inputs(args, dir);
+  const int status = failed ? *failed : run_process_files(args);
+  if (args.session_dir.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir, ignored);
+  }
+  return status;
+}
+
+int run_process_files(const ProcessArgs& args) {
   using canyon::config::ProcessConfig;
   if (args.describe_config != nullptr && args.describe_config->count() > 0) {
     return print_key_descriptions(args.describe_what, args.mode);
@@ -710,8 +781,10 @@ int run_main(int argc, char** argv) {
 
 }  // namespace
 
-/// `canyon base ...` runs `canyon-base ...` (the DDS executable next to this one) with the same arguments.
-int exec_dds_command(const std::string& command, int argc, char** argv) {
+namespace {
+
+/// canyon-COMMAND next to this executable.
+std::string sibling_program(const std::string& command) {
   char self[4096];
   const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
   std::string dir = ".";
@@ -720,7 +793,14 @@ int exec_dds_command(const std::string& command, int argc, char** argv) {
     dir = self;
     dir = dir.substr(0, dir.find_last_of('/'));
   }
-  const std::string program = dir + "/canyon-" + command;
+  return dir + "/canyon-" + command;
+}
+
+}  // namespace
+
+/// `canyon base ...` runs `canyon-base ...` (the DDS executable next to this one) with the same arguments.
+int exec_dds_command(const std::string& command, int argc, char** argv) {
+  const std::string program = sibling_program(command);
   if (access(program.c_str(), X_OK) != 0) {
     std::cerr << "canyon: error: '" << command << "' runs " << program
               << ", which is missing (build it: cmake --build build --target canyon-" << command << ")\n";

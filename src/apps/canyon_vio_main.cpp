@@ -1,6 +1,7 @@
 // canyon-vio: publishes a VIO run on DDS, as a VIO node would: the poses of vio.csv as canyon::msg::VioPose samples
 // (topic canyon/vio) and the device's time-sync pairs of timesync.csv as TimeSyncSample samples (canyon/timesync),
-// merged in device-time order, at real-time pace or faster (--pace; 0: as fast as the readers acknowledge).
+// merged in device-time order, at real-time pace or faster (--pace; 0: as fast as the readers acknowledge); with
+// --ros2 each pose as nav_msgs/msg/Odometry on ROS 2's names instead.
 // `canyon vio ...` runs this executable; canyon rover with input.vio dds subscribes. SIGINT/SIGTERM stop it.
 // The application is canyon::dds::VioApp. Exit codes: 0 success, 1 input or runtime failure, 2 bad command line.
 
@@ -37,6 +38,12 @@ int run(int argc, char** argv) {
                  "At the end, stay up to this many seconds while readers are matched (a reader still taking the "
                  "last samples from shared memory loses them when the writer goes)")
       ->check(CLI::NonNegativeNumber);
+  cli.add_flag("--ros2", a.ros2,
+               "Publish nav_msgs/msg/Odometry on rt/<--ros2-topic> instead, as a ROS 2 VIO node (poses on GPST: no "
+               "--timesync; canyon rover input.vio ros2 reads it)");
+  cli.add_option("--ros2-topic", a.ros2_topic, "--ros2: the ROS 2 topic (DDS topic rt/ + this)");
+  cli.add_option("--ros2-frame-id", a.ros2_frame_id, "--ros2: header.frame_id, the VIO's odometry frame");
+  cli.add_option("--ros2-child-frame-id", a.ros2_child_frame_id, "--ros2: child_frame_id, the IMU frame");
   cli.add_flag("-q,--quiet", quiet, "Warnings and errors only");
   try {
     cli.parse(argc, argv);

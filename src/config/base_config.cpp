@@ -128,11 +128,23 @@ const Table<B::Tcp>& tcp_table() {
   return table;
 }
 
+const Table<B::Ros2>& ros2_table() {
+  using R = B::Ros2;
+  static const Table<R> table{
+      {"enabled", "", "publish every frame as rtcm_msgs/msg/Message on ROS 2's names (domain, profiles: dds's)",
+       at(&R::enabled)},
+      {"topic", "", "ROS 2 topic (DDS topic rt/ + this)", at(&R::topic)},
+      {"frame_id", "", "header.frame_id", at(&R::frame_id)},
+  };
+  return table;
+}
+
 const Table<B>& outputs_table() {
   static const Table<B> table{
       {"dds", "the DDS topic", at(&B::dds), dds_table()},
       {"ntrip", "the NTRIP caster", at(&B::ntrip), ntrip_table()},
       {"tcp", "the plain TCP server", at(&B::tcp), tcp_table()},
+      {"ros2", "the ROS 2 topic (off by default)", at(&B::ros2), ros2_table()},
   };
   return table;
 }
@@ -213,7 +225,10 @@ std::string BaseConfig::validate() const {
     return "outputs.ntrip.user and outputs.ntrip.password go together";
   }
   if (tcp.enabled && (tcp.port < 0 || tcp.port > 65535)) return "outputs.tcp.port must be within 0-65535";
-  if (!dds.enabled && !ntrip.enabled && !tcp.enabled) return "at least one output (dds, ntrip, tcp) must be enabled";
+  if (ros2.enabled && ros2.topic.empty()) return "outputs.ros2.topic must not be empty";
+  if (!dds.enabled && !ntrip.enabled && !tcp.enabled && !ros2.enabled) {
+    return "at least one output (dds, ntrip, tcp, ros2) must be enabled";
+  }
   if (!(progress_interval_s >= 0.0)) return "log.progress_interval_s must be >= 0";
   return {};
 }

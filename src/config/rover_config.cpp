@@ -152,6 +152,10 @@ const Table<R>& dds_table() {
       {"timesync_topic", "", "canyon::msg::TimeSyncSample in (input.vio dds)", at(&R::timesync_topic)},
       {"publish_stages", "", "also the stages' outputs: canyon/bridged, alignment, prior and float",
        at(&R::publish_stages)},
+      {"publish_observations", "",
+       "also the rover's observation epochs as ingested: canyon/observations (a recorded session then holds the "
+       "rover's inputs: canyon process --session)",
+       at(&R::publish_observations)},
   };
   return table;
 }

@@ -2,6 +2,7 @@
 
 #include "canyon/dds/play_app.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 #include <utility>
@@ -46,7 +47,17 @@ PlayApp::PlayApp(PlayOptions options) : options_(std::move(options)) {
   }
   const ProfileSet profiles = value_or_throw(load_profiles(options_.profiles), kExitUsage);
   participant_ = value_or_throw(DdsParticipant::create(options_.domain, profiles.participant_profile()), kExitRuntime);
+  for (const std::string& topic : options_.topics) {
+    const auto in_session = [&](const auto& entry) { return entry.second.topic == topic; };
+    if (std::none_of(session_.channels.begin(), session_.channels.end(), in_session)) {
+      throw AppError(kExitUsage, Error{"topic '" + topic + "' (--topic) is not in the session", options_.session, 0});
+    }
+  }
   for (const auto& [id, channel] : session_.channels) {
+    if (!options_.topics.empty() &&
+        std::find(options_.topics.begin(), options_.topics.end(), channel.topic) == options_.topics.end()) {
+      continue;
+    }
     const auto schema = session_.schemas.find(channel.schema_id);
     const auto known = recorded_topic(channel.topic);
     if (schema == session_.schemas.end() || schema->second.encoding != "omgidl" || channel.message_encoding != "cdr" ||

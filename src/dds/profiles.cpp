@@ -63,6 +63,7 @@ const std::vector<RequestedProfile>& requested_profiles() {
       {K::DataReader, profile::kRos2SensorDataReader, "canyon-ros2-raw (tests: ROS 2 samples as bytes)"},
       {K::DataWriter, profile::kRos2DefaultWriter, "canyon rover ros2 (DiagnosticArray)"},
       {K::DataReader, profile::kRos2DefaultReader, "canyon-ros2-raw (tests: ROS 2 samples as bytes)"},
+      {K::DataWriter, profile::kRos2StreamWriter, "canyon base outputs.ros2 (rtcm_msgs), canyon vio --ros2"},
   };
   return requested;
 }

@@ -74,12 +74,14 @@ std::optional<RecordedTopic> recorded_topic(const std::string& topic) {
       {"alignment", "canyon::msg::Alignment", profile::kStageReader, profile::kStageWriter},
       {"vio", "canyon::msg::VioPose", profile::kVioReader, profile::kVioWriter},
       {"timesync", "canyon::msg::TimeSyncSample", profile::kVioReader, profile::kVioWriter},
+      {"observations", "canyon::msg::GnssObservationEpoch", profile::kStageReader, profile::kStageWriter},
   };
   static const Known kRos2[] = {
       {"fix", "sensor_msgs::msg::dds_::NavSatFix_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
       {"odometry", "nav_msgs::msg::dds_::Odometry_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
       {"diagnostics", "diagnostic_msgs::msg::dds_::DiagnosticArray_", profile::kRos2DefaultReader,
        profile::kRos2DefaultWriter},
+      {"rtcm", "rtcm_msgs::msg::dds_::Message_", profile::kRos2DefaultReader, profile::kRos2StreamWriter},
   };
   if (topic.rfind("rt/", 0) == 0) {
     for (const Known& k : kRos2) {

@@ -3,6 +3,7 @@
 #include "canyon/dds/ros2_msgs.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -152,6 +153,58 @@ nav_msgs::msg::dds_::Odometry_ to_odometry(const core::Solution& solution, const
   put_row_major<6>(twist_covariance, twist.covariance());
   odometry.twist(twist);
   return odometry;
+}
+
+nav_msgs::msg::dds_::Odometry_ to_ros2_odometry(const io::VioRecord& record, const std::string& frame_id,
+                                                const std::string& child_frame_id, const core::LeapSecondTable& leaps) {
+  constexpr std::int64_t kNsPerS = 1000000000;
+  const std::int64_t gps_s = record.t_ns / kNsPerS;
+  const core::GpsTime whole{static_cast<int>(gps_s / core::kSecondsPerWeek),
+                            static_cast<double>(gps_s % core::kSecondsPerWeek)};
+  builtin_interfaces::msg::dds_::Time_ stamp;
+  stamp.sec(static_cast<std::int32_t>(kGpsEpochPosixS + gps_s - leaps.gps_minus_utc_at_gps(whole)));
+  stamp.nanosec(static_cast<std::uint32_t>(record.t_ns % kNsPerS));
+  nav_msgs::msg::dds_::Odometry_ odometry;
+  std_msgs::msg::dds_::Header_ h;
+  h.stamp(stamp);
+  h.frame_id(frame_id);
+  odometry.header(h);
+  odometry.child_frame_id(child_frame_id);
+  geometry_msgs::msg::dds_::PoseWithCovariance_ pose;
+  pose.pose().position().x(record.T_OI.p.x());
+  pose.pose().position().y(record.T_OI.p.y());
+  pose.pose().position().z(record.T_OI.p.z());
+  pose.pose().orientation().x(record.T_OI.q.x());
+  pose.pose().orientation().y(record.T_OI.q.y());
+  pose.pose().orientation().z(record.T_OI.q.z());
+  pose.pose().orientation().w(record.T_OI.q.w());
+  put_row_major<6>(ros2_pose_covariance(record.covariance, record.T_OI), pose.covariance());
+  odometry.pose(pose);
+  geometry_msgs::msg::dds_::TwistWithCovariance_ twist;  // a pose-only VIO output: the twist is unknown
+  put_row_major<6>(Matrix6d(Matrix6d::Identity() * kUnknownVariance), twist.covariance());
+  odometry.twist(twist);
+  return odometry;
+}
+
+rtcm_msgs::msg::dds_::Message_ to_ros2_rtcm(const std::vector<std::uint8_t>& frame,
+                                            const builtin_interfaces::msg::dds_::Time_& sent,
+                                            const std::string& frame_id) {
+  rtcm_msgs::msg::dds_::Message_ message;
+  std_msgs::msg::dds_::Header_ h;
+  h.stamp(sent);
+  h.frame_id(frame_id);
+  message.header(h);
+  message.message(frame);
+  return message;
+}
+
+builtin_interfaces::msg::dds_::Time_ ros_time_now() {
+  const auto since_epoch = std::chrono::system_clock::now().time_since_epoch();
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(since_epoch).count();
+  builtin_interfaces::msg::dds_::Time_ time;
+  time.sec(static_cast<std::int32_t>(ns / 1000000000));
+  time.nanosec(static_cast<std::uint32_t>(ns % 1000000000));
+  return time;
 }
 
 core::Matrix6d ros2_pose_covariance(const core::Matrix6d& xi_covariance, const core::Pose& T_OI) {

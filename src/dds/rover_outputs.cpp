@@ -44,6 +44,9 @@ RoverOutputs::RoverOutputs(DdsParticipant& participant, const config::RoverConfi
                                    ros2_.enu_origin_llh[2]};
     }
   }
+  if (config.publish_observations) {
+    observations_ = create_writer<ObservationWriter>(participant, "canyon/observations", profile::kStageWriter);
+  }
   if (!config.publish_stages) return;
   prior_ = create_writer<PriorWriter>(participant, "canyon/prior", profile::kStageWriter);
   float_ = create_writer<FloatWriter>(participant, "canyon/float", profile::kStageWriter);
@@ -109,6 +112,11 @@ void RoverOutputs::take_solved(const pipeline::SolvedEpoch& item) {
   update_context(item);
   auto solution = to_msg_solution(item, context_);
   if (!solution_->write(solution)) refused_.fetch_add(1);
+  if (observations_) {
+    const pipeline::IngestedEpoch& epoch = item.epoch();
+    auto observations = to_msg(epoch.rover, observations_sent_++, rover_id_, epoch.arrival_ns);
+    if (!observations_->write(observations)) refused_.fetch_add(1);
+  }
   timing_pending_ = to_msg_timing(item, context_);
   if (prior_) {
     prior_pending_ = to_msg_prior(item);

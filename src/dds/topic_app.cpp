@@ -108,7 +108,7 @@ TopicApp::TopicApp(TopicOptions options)
     for (const std::string& topic : mcap_topics()) {
       if (!recorded_topic(topic)) {
         throw AppError(kExitUsage, Error{"unknown topic '" + topic + "': " + kKnownTopics +
-                                         ", or rt/canyon/fix, rt/canyon/odometry, rt/diagnostics"});
+                                         ", or ROS 2 topics rt/...fix, rt/...odometry, rt/...diagnostics, rt/...rtcm"});
       }
     }
   } else if (!monitor && !known_topic(options_.topic)) {
@@ -212,7 +212,7 @@ void TopicApp::open_record_output() {
   } else if (ends_with(options_.topic, "vio")) {
     raw_ << io::vio_csv_header() << '\n';
   } else if (ends_with(options_.topic, "timesync")) {
-    raw_ << "t_ns,gps_week,gps_tow_s\n";
+    raw_ << io::timesync_csv_header() << '\n';
   }
 }
 
@@ -346,10 +346,10 @@ void TopicApp::on_vio(msg::VioPose&& m) {
 
 void TopicApp::on_timesync(msg::TimeSyncSample&& m) {
   if (options_.tool == TopicTool::Echo) return on_text(describe(m));
-  char line[96];
-  std::snprintf(line, sizeof line, "%lld,%d,%.17g", static_cast<long long>(m.device_time_ns()), m.gps_week(),
-                m.gps_tow_s());
-  on_text(line);
+  io::TimeSyncPair pair;
+  pair.t_ns = m.device_time_ns();
+  pair.time = core::GpsTime{m.gps_week(), m.gps_tow_s()};
+  on_text(io::timesync_csv_row(pair));
 }
 
 void TopicApp::report() {

@@ -98,6 +98,16 @@ std::string vio_csv_header() {
   return header;
 }
 
+std::string timesync_csv_header() {
+  return "t_ns,gps_week,gps_tow_s";
+}
+
+std::string timesync_csv_row(const TimeSyncPair& pair) {
+  char line[96];
+  std::snprintf(line, sizeof line, "%lld,%d,%.17g", static_cast<long long>(pair.t_ns), pair.time.week, pair.time.tow_s);
+  return line;
+}
+
 std::string vio_csv_row(const VioRecord& record) {
   std::string row = std::to_string(record.t_ns);
   char value[32];

@@ -108,7 +108,7 @@ TEST(BaseConfigTest, ValidationNamesTheRule) {
   EXPECT_NE(bad.validate().find("input.host and input.port"), std::string::npos);
   bad = c;
   bad.dds.enabled = bad.ntrip.enabled = bad.tcp.enabled = false;
-  EXPECT_EQ(bad.validate(), "at least one output (dds, ntrip, tcp) must be enabled");
+  EXPECT_EQ(bad.validate(), "at least one output (dds, ntrip, tcp, ros2) must be enabled");
   bad = c;
   bad.ntrip.user = "u";
   EXPECT_NE(bad.validate().find("go together"), std::string::npos);

@@ -146,6 +146,60 @@ if ! cmp -s <(grep -v '^%' "$tmp/from_file.pos") <(grep -v '^%' "$tmp/from_ros2.
 fi
 echo "input.vio ros2: $(grep -vc '^%' "$tmp/from_ros2.pos") solutions equal, byte for byte, to the same poses from a file"
 
+# canyon vio --ros2, a ROS 2 VIO node: its Odometry, off the wire, equals the independently encoded poses, and drives
+# the rover to the same solutions, byte for byte, as the file.
+poses=$(($(wc -l < "$tmp/vio_gps.csv") - 1))
+vio_rover from_canyon_vio ros2
+record rt/vio/odometry nav_msgs::msg::dds_::Odometry_ default vio_odom.bin "$poses"
+odom_rec=$!
+"$canyon" vio --vio "$tmp/vio_gps.csv" --ros2 --pace 0 --wait-for-readers 2 --domain "$domain" -q > "$tmp/vio.log" 2>&1 &
+vio_pid=$!
+pids+=("$vio_pid")
+"$canyon" rover --config "$tmp/from_canyon_vio.yaml" -q > "$tmp/from_canyon_vio.log" 2>&1
+wait "$vio_pid" || { echo "FAIL: canyon vio --ros2: $(cat "$tmp/vio.log")"; exit 1; }
+wait "$odom_rec" || { echo "FAIL: recording canyon vio's Odometry: $(cat "$tmp/vio_odom.bin.log")"; exit 1; }
+node "$decoders/streams_check.mjs" odometry "$tmp/vio_odom.bin" "$tmp/odometry.bin"
+if ! cmp -s <(grep -v '^%' "$tmp/from_file.pos") <(grep -v '^%' "$tmp/from_canyon_vio.pos"); then
+  echo "FAIL: the rover on canyon vio --ros2 differs from the same poses from a file:"
+  diff <(grep -v '^%' "$tmp/from_file.pos") <(grep -v '^%' "$tmp/from_canyon_vio.pos") | head -5
+  exit 1
+fi
+echo "canyon vio --ros2 -> canyon rover input.vio ros2: the same $(grep -vc '^%' "$tmp/from_file.pos") solutions"
+rc=0
+"$canyon" vio --vio "$tmp/sim/vio.csv" --timesync "$tmp/sim/timesync.csv" --ros2 > "$tmp/vio_bad.log" 2>&1 || rc=$?
+[[ $rc -eq 2 ]] && grep -qF "needs poses stamped with GPST: leave out --timesync" "$tmp/vio_bad.log" ||
+  { echo "FAIL: canyon vio --ros2 --timesync: exit $rc, $(cat "$tmp/vio_bad.log")"; exit 1; }
+
+# canyon base outputs.ros2: every RTCM 3 frame as rtcm_msgs/msg/Message; decoded independently and joined, the
+# frames are the base's canyon/rtcm stream byte for byte, and RTKLIB's convbin reads that stream back to every epoch.
+cat > "$tmp/base.yaml" << EOF
+input: {kind: rinex, source: file, path: $tmp/sim/base.obs, nav: [$tmp/sim/nav.rnx], pace: 10}
+outputs:
+  dds: {enabled: true, domain: $domain}
+  ntrip: {enabled: false}
+  ros2: {enabled: true, frame_id: base_antenna}
+log: {progress_interval_s: 0}
+EOF
+record rt/rtcm rtcm_msgs::msg::dds_::Message_ default rtcm.bin 0
+rtcm_ros2=$!
+"$canyon" record canyon/rtcm --out "$tmp/base.rtcm3" --domain "$domain" > "$tmp/rtcm_rec.log" 2>&1 &
+rtcm_rec=$!
+pids+=("$rtcm_rec")
+"$canyon" base --config "$tmp/base.yaml" --wait-for-clients 2 -q
+wait "$rtcm_ros2" || { echo "FAIL: recording rt/rtcm: $(cat "$tmp/rtcm.bin.log")"; exit 1; }
+kill -INT "$rtcm_rec" 2> /dev/null || true  # it ends by itself once the base has left
+wait "$rtcm_rec" || { echo "FAIL: canyon record canyon/rtcm: $(cat "$tmp/rtcm_rec.log")"; exit 1; }
+node "$decoders/streams_check.mjs" rtcm "$tmp/rtcm.bin" "$tmp/base.rtcm3" base_antenna
+base_epochs=$(grep -c '^>' "$tmp/sim/base.obs")
+# convbin's -tr takes the date and the time as two arguments.
+read -r day clock < <(awk '/TIME OF FIRST OBS/ {printf "%04d/%02d/%02d %02d:%02d:%02d\n", $1, $2, $3, $4, $5, $6}' "$tmp/sim/base.obs")
+mkdir -p "$tmp/convbin"
+convbin -r rtcm3 -v 3.04 -tr "$day" "$clock" -d "$tmp/convbin" "$tmp/base.rtcm3" > /dev/null 2>&1 || true
+read_back=$(grep -c '^>' "$tmp/convbin/base.obs" 2> /dev/null || true)
+[[ ${read_back:-0} -eq $base_epochs ]] ||
+  { echo "FAIL: RTKLIB convbin read ${read_back:-0} epochs of the ROS 2 RTCM stream, the base file has $base_epochs"; exit 1; }
+echo "RTKLIB convbin: the RTCM 3 stream carried on ROS 2 holds all $base_epochs base epochs"
+
 # Bad input: refused sample by sample, each named.
 node "$decoders/encode_odometry.mjs" "$tmp/sim/vio.csv" "$tmp/sim/timesync.csv" "$tmp" --bad
 publish "$tmp/odometry.bin" "$tmp/publish_bad.log"

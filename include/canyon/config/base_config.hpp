@@ -9,7 +9,7 @@
 //              serial baud, host / port / mountpoint / user / password
 //   rtcm:      msm (7 | 4), station_interval_s, ephemeris_interval_s
 //   outputs:   dds (enabled, domain, topic, profiles file), ntrip (enabled, bind, port, mountpoint, user, password),
-//              tcp (enabled, bind, port)
+//              tcp (enabled, bind, port), ros2 (enabled, topic, frame_id)
 //   log:       progress_interval_s
 
 #include <optional>
@@ -74,6 +74,12 @@ struct BaseConfig {
     std::string bind = "0.0.0.0";
     int port = 2102;
   } tcp;
+  /// rtcm_msgs/msg/Message on ROS 2's names (DDS topic rt/ + topic), on the domain and profiles of `dds`.
+  struct Ros2 {
+    bool enabled = false;
+    std::string topic = "rtcm";          ///< the ROS 2 topic (ntrip_client's name)
+    std::string frame_id = "gnss_base";  ///< header.frame_id
+  } ros2;
   double progress_interval_s = 10.0;  ///< a progress line every this many seconds (0: none)
 
   /// Empty if complete and consistent, else the first violated rule.

@@ -65,7 +65,8 @@ struct RoverConfig {
   std::string timing_topic = "canyon/timing";
   std::string vio_topic = "canyon/vio";            ///< canyon::msg::VioPose in (input.vio dds)
   std::string timesync_topic = "canyon/timesync";  ///< canyon::msg::TimeSyncSample in (input.vio dds)
-  bool publish_stages = true;  ///< also canyon/bridged, canyon/alignment, canyon/prior, canyon/float
+  bool publish_stages = true;         ///< also canyon/bridged, canyon/alignment, canyon/prior, canyon/float
+  bool publish_observations = false;  ///< also canyon/observations: the rover's epochs as ingested
   Ros2Options ros2;
 
   /// Empty if usable, else the first broken rule.

@@ -1,7 +1,7 @@
 #pragma once
 // canyon base: the base station. Reads the base receiver (base::BaseStation), produces RTCM 3 and publishes it as
-// RtcmFrame samples on a DDS topic and on its NTRIP caster and TCP server (app.hpp: constructed, run() once, stop()
-// from anywhere).
+// RtcmFrame samples on a DDS topic (and as ROS 2's rtcm_msgs/msg/Message with outputs.ros2), on its NTRIP caster and
+// TCP server (app.hpp: constructed, run() once, stop() from anywhere).
 
 #include <atomic>
 #include <cstdint>
@@ -11,6 +11,7 @@
 #include "canyon/config/base_config.hpp"
 #include "canyon/dds/app.hpp"
 #include "canyon/dds/dds.hpp"
+#include "canyon/dds/ros2_msgs.hpp"
 #include "canyon/dds/rtcm_frame.hpp"
 
 namespace canyon::dds {
@@ -42,8 +43,9 @@ class BaseApp {
   void create_dds_output();
 
   BaseOptions options_;
-  std::unique_ptr<DdsParticipant> participant_;  ///< outputs.dds.enabled only
-  std::unique_ptr<RtcmWriter> writer_;
+  std::unique_ptr<DdsParticipant> participant_;     ///< outputs.dds.enabled or outputs.ros2.enabled
+  std::unique_ptr<RtcmWriter> writer_;              ///< outputs.dds.enabled only
+  std::unique_ptr<RtcmMessageWriter> ros2_writer_;  ///< outputs.ros2.enabled only
   std::atomic<std::uint64_t> refused_{0};
   std::unique_ptr<base::BaseStation> base_;
 };

@@ -5,7 +5,7 @@
 // (--pace; 0: as fast as the writers take them). (app.hpp: constructed, run() once, stop() from anywhere.)
 // Bad input: a file cut short plays the messages before the cut (a warning names the byte); a channel whose schema
 // canyon does not know (another encoding, another type, a topic canyon does not publish) is left out with a warning
-// naming it; a file with no channel to play is an error.
+// naming it; a file with no channel to play is an error, and so is a selected topic (--topic) the file does not have.
 
 #include <atomic>
 #include <cstdint>
@@ -20,13 +20,14 @@
 namespace canyon::dds {
 
 struct PlayOptions {
-  std::string session;           ///< the MCAP file
-  double pace = 1.0;             ///< 1 real time, 10 ten times faster, 0 as fast as the writers take them
-  int domain = 0;                ///< DDS domain id
-  std::string profiles;          ///< deployment profile file on top of the shipped QoS; "": none
-  int wait_readers = 0;          ///< start once this many readers of each played topic are matched
-  double wait_timeout_s = 30.0;  ///< give up waiting for readers after this long (s)
-  double linger_s = 2.0;         ///< at the end, stay up this long (s) while readers are matched
+  std::string session;              ///< the MCAP file
+  double pace = 1.0;                ///< 1 real time, 10 ten times faster, 0 as fast as the writers take them
+  std::vector<std::string> topics;  ///< play only these (each must be in the session); empty: every channel
+  int domain = 0;                   ///< DDS domain id
+  std::string profiles;             ///< deployment profile file on top of the shipped QoS; "": none
+  int wait_readers = 0;             ///< start once this many readers of each played topic are matched
+  double wait_timeout_s = 30.0;     ///< give up waiting for readers after this long (s)
+  double linger_s = 2.0;            ///< at the end, stay up this long (s) while readers are matched
 };
 
 class PlayApp {

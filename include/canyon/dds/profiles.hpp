@@ -41,6 +41,9 @@ inline constexpr char kRos2SensorDataWriter[] = "ros2_sensor_data_writer";
 inline constexpr char kRos2SensorDataReader[] = "ros2_sensor_data_reader";
 inline constexpr char kRos2DefaultWriter[] = "ros2_default_writer";
 inline constexpr char kRos2DefaultReader[] = "ros2_default_reader";
+/// ROS 2's default QoS with a deeper history (keep last 256; depth plays no part in matching): streams that come in
+/// bursts and must not lose a sample (canyon base's RTCM, canyon vio's Odometry).
+inline constexpr char kRos2StreamWriter[] = "ros2_stream_writer";
 }  // namespace profile
 
 enum class ProfileKind { Participant, DataWriter, DataReader };

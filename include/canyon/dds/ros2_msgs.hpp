@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "canyon/config/rover_config.hpp"
 #include "canyon/core/geodesy.hpp"
@@ -36,6 +37,7 @@ namespace canyon::dds {
 using NavSatFixWriter = DdsWriter<sensor_msgs::msg::dds_::NavSatFix_, sensor_msgs::msg::dds_::NavSatFix_PubSubType>;
 using OdometryWriter = DdsWriter<nav_msgs::msg::dds_::Odometry_, nav_msgs::msg::dds_::Odometry_PubSubType>;
 using OdometryReader = DdsReader<nav_msgs::msg::dds_::Odometry_, nav_msgs::msg::dds_::Odometry_PubSubType>;
+using RtcmMessageWriter = DdsWriter<rtcm_msgs::msg::dds_::Message_, rtcm_msgs::msg::dds_::Message_PubSubType>;
 using DiagnosticsWriter =
     DdsWriter<diagnostic_msgs::msg::dds_::DiagnosticArray_, diagnostic_msgs::msg::dds_::DiagnosticArray_PubSubType>;
 
@@ -79,6 +81,23 @@ inline constexpr double kUnknownVariance = 1e9;
 /// that is not finite, a quaternion that is no rotation, a covariance that is not positive definite.
 Result<io::VioRecord> from_ros2_odometry(const nav_msgs::msg::dds_::Odometry_& odometry,
                                          const config::Ros2Options& options, const core::LeapSecondTable& leaps);
+
+/// A VIO pose stamped on GPST (`record.t_ns`: ns since the GPS epoch) as a ROS 2 VIO node publishes it (canyon vio
+/// --ros2): from_ros2_odometry's conventions the other way round, frames `frame_id` -> `child_frame_id`, the twist
+/// unknown (zero, kUnknownVariance on the diagonal). from_ros2_odometry gives the record back (the covariance to
+/// rounding).
+[[nodiscard]] nav_msgs::msg::dds_::Odometry_ to_ros2_odometry(const io::VioRecord& record, const std::string& frame_id,
+                                                              const std::string& child_frame_id,
+                                                              const core::LeapSecondTable& leaps);
+
+/// An RTCM 3 frame as rtcm_msgs/msg/Message (canyon base with outputs.ros2): the frame's bytes (preamble to CRC) in
+/// `message`; header.stamp `sent` (ROS time of sending, as NTRIP clients on ROS 2 stamp what they receive).
+[[nodiscard]] rtcm_msgs::msg::dds_::Message_ to_ros2_rtcm(const std::vector<std::uint8_t>& frame,
+                                                          const builtin_interfaces::msg::dds_::Time_& sent,
+                                                          const std::string& frame_id);
+
+/// ROS time now (the system clock).
+[[nodiscard]] builtin_interfaces::msg::dds_::Time_ ros_time_now();
 
 /// The inverse of from_ros2_odometry's covariance mapping: canyon's xi_OI covariance as Odometry's, in frame O.
 [[nodiscard]] core::Matrix6d ros2_pose_covariance(const core::Matrix6d& xi_covariance, const core::Pose& T_OI);

@@ -18,6 +18,7 @@
 
 #include "canyon/config/rover_config.hpp"
 #include "canyon/dds/dds.hpp"
+#include "canyon/dds/observation_msgs.hpp"
 #include "canyon/dds/ros2_msgs.hpp"
 #include "canyon/dds/rover_msgs.hpp"
 #include "canyon/io/pos_file.hpp"
@@ -79,6 +80,8 @@ class RoverOutputs {
   std::unique_ptr<AlignmentWriter> alignment_;
   std::unique_ptr<PriorWriter> prior_;
   std::unique_ptr<FloatWriter> float_;
+  std::unique_ptr<ObservationWriter> observations_;  ///< dds.publish_observations only
+  std::uint64_t observations_sent_ = 0;
   config::Ros2Options ros2_;
   core::LeapSecondTable leaps_;
   std::unique_ptr<NavSatFixWriter> ros2_fix_;

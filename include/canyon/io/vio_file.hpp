@@ -69,5 +69,9 @@ Result<VioFile> read_vio_csv(const std::string& path);
 /// cross-covariance is written as zeros, which the reader takes the same way.
 [[nodiscard]] std::string vio_csv_row(const VioRecord& record);
 Result<TimeSyncFile> read_timesync_csv(const std::string& path);
+/// timesync.csv's header row ("t_ns,gps_week,gps_tow_s").
+[[nodiscard]] std::string timesync_csv_header();
+/// A timesync.csv row of `pair`, the time of week with 17 significant digits (read back exactly).
+[[nodiscard]] std::string timesync_csv_row(const TimeSyncPair& pair);
 
 }  // namespace canyon::io
