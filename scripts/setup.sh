@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build git pkg-config
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
-  libeigen3-dev libceres-dev libspdlog-dev libyaml-cpp-dev libcli11-dev zlib1g-dev
+  libeigen3-dev libceres-dev libspdlog-dev libyaml-cpp-dev libcli11-dev zlib1g-dev libzstd-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   clang-format clang-tidy clang-14 libclang-rt-14-dev
   rtklib
