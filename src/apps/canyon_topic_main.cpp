@@ -41,8 +41,9 @@ int run(dds::TopicTool tool, int argc, char** argv) {
   if (tool != dds::TopicTool::Monitor) {
     cli.add_option("topic", topics,
                    "canyon/solution, canyon/timing, canyon/rtcm, canyon/bridged, canyon/alignment, canyon/prior, "
-                   "canyon/float, canyon/vio or canyon/timesync (record to .mcap: any number of them, and the ROS "
-                   "2 topics rt/canyon/fix, rt/canyon/odometry, rt/diagnostics)")
+                   "canyon/float, canyon/vio or canyon/timesync (record to .mcap: any number of them, "
+                   "canyon/observations, and the ROS 2 topics rt/canyon/fix, rt/canyon/odometry, rt/diagnostics, "
+                   "rt/vio/odometry, rt/rtcm)")
         ->required();
   } else {
     add_monitor_options(cli, o);
@@ -53,6 +54,13 @@ int run(dds::TopicTool tool, int argc, char** argv) {
            "Output file: .pos, .nmea or .csv (solutions), .rtcm3 (canyon/rtcm), .csv; .mcap: every topic given, "
            "as it came off the wire, with its schema (Foxglove, mcap tools, canyon play)")
         ->required();
+    cli.add_option("--mcap-compression", o.mcap.compression,
+                   ".mcap: zstd (indexed chunks, the default) or \"\" (unchunked, uncompressed messages)")
+        ->check(CLI::IsMember({"zstd", ""}));
+    cli.add_option("--mcap-chunk-kib", o.mcap_chunk_kib,
+                   ".mcap with zstd: uncompressed KiB per chunk (a chunk reaches the file when full or at the end; "
+                   "SIGINT and SIGTERM end the recording cleanly, a killed recorder loses its open chunk)")
+        ->check(CLI::Range(1, 65536));
   }
   cli.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 232));
   cli.add_option("--profiles", o.profiles,

@@ -156,6 +156,10 @@ const Table<R>& dds_table() {
        "also the rover's observation epochs as ingested: canyon/observations (a recorded session then holds the "
        "rover's inputs: canyon process --session)",
        at(&R::publish_observations)},
+      {"record", "",
+       "SESSION.mcap: every topic this rover publishes, recorded in-process as canyon record would take it off the "
+       "wire (zstd chunks); \"\": none",
+       at(&R::record), Path{}},
   };
   return table;
 }

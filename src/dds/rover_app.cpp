@@ -7,6 +7,7 @@
 #include <utility>
 
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
 
 #include "canyon/commands/process.hpp"
 #include "canyon/pipeline/cpu_affinity.hpp"
@@ -312,6 +313,20 @@ void RoverApp::log_start() const {
   }
 }
 
+namespace {
+
+/// The CPU time (user and system) this process has used so far (s).
+double process_cpu_s() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+}  // namespace
+
 int RoverApp::run() {
   wait_for_subscribers();
   log_start();
@@ -319,6 +334,7 @@ int RoverApp::run() {
   Status status = pipeline_->run();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (Status c = outputs_->close_pos(); !c && status) status = c;
+  if (Status c = outputs_->close_record(process_cpu_s()); !c && status) status = c;
   if (!outputs_->wait_for_acknowledgments(5.0)) {
     spdlog::warn("DDS: not every solution was acknowledged by every reader within 5 s");
   }

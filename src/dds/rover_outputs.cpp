@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include <spdlog/spdlog.h>
+
 #include "canyon/dds/app.hpp"
 #include "canyon/io/nmea.hpp"
 
@@ -47,13 +49,48 @@ RoverOutputs::RoverOutputs(DdsParticipant& participant, const config::RoverConfi
   if (config.publish_observations) {
     observations_ = create_writer<ObservationWriter>(participant, "canyon/observations", profile::kStageWriter);
   }
-  if (!config.publish_stages) return;
-  prior_ = create_writer<PriorWriter>(participant, "canyon/prior", profile::kStageWriter);
-  float_ = create_writer<FloatWriter>(participant, "canyon/float", profile::kStageWriter);
-  if (config.estimator.mode == config::ProcessMode::Fusion) {
-    bridged_ = create_writer<BridgedWriter>(participant, "canyon/bridged", profile::kStageWriter);
-    alignment_ = create_writer<AlignmentWriter>(participant, "canyon/alignment", profile::kStageWriter);
+  if (config.publish_stages) {
+    prior_ = create_writer<PriorWriter>(participant, "canyon/prior", profile::kStageWriter);
+    float_ = create_writer<FloatWriter>(participant, "canyon/float", profile::kStageWriter);
+    if (config.estimator.mode == config::ProcessMode::Fusion) {
+      bridged_ = create_writer<BridgedWriter>(participant, "canyon/bridged", profile::kStageWriter);
+      alignment_ = create_writer<AlignmentWriter>(participant, "canyon/alignment", profile::kStageWriter);
+    }
   }
+  if (!config.record.empty()) start_recording(config);
+}
+
+template <typename Writer>
+void RoverOutputs::record(Writer* writer, const std::string& topic) {
+  if (writer == nullptr) return;
+  writer->record_to(*recorder_, value_or_throw(recorder_->channel(topic), kExitRuntime));
+}
+
+void RoverOutputs::start_recording(const config::RoverConfig& config) {
+  recorder_ = value_or_throw(SessionRecorder::create(config.record, {}), kExitRuntime);
+  record(solution_.get(), config.solution_topic);
+  record(timing_.get(), config.timing_topic);
+  record(observations_.get(), "canyon/observations");
+  record(prior_.get(), "canyon/prior");
+  record(float_.get(), "canyon/float");
+  record(bridged_.get(), "canyon/bridged");
+  record(alignment_.get(), "canyon/alignment");
+  record(ros2_fix_.get(), ros2_dds_topic(ros2_.fix_topic));
+  record(ros2_odometry_.get(), ros2_dds_topic(ros2_.odometry_topic));
+  record(ros2_diagnostics_.get(), ros2_dds_topic(ros2_.diagnostics_topic));
+}
+
+Status RoverOutputs::close_record(double process_cpu_s) {
+  if (!recorder_) return Ok{};
+  const std::int64_t start = thread_cpu_ns();
+  Status closed = recorder_->close();  // the last chunk is compressed here
+  recorder_->add_cpu_ns(thread_cpu_ns() - start);
+  const double cpu_s = 1e-9 * static_cast<double>(recorder_->cpu_ns());
+  spdlog::info(
+      "recorded {} messages ({} bytes) to {}; recording took {:.3f} s of CPU, {:.2f} % of the rover's {:.2f} s",
+      recorder_->messages(), recorder_->bytes(), recorder_->path(), cpu_s,
+      process_cpu_s > 0.0 ? 100.0 * cpu_s / process_cpu_s : 0.0, process_cpu_s);
+  return closed;
 }
 
 RoverOutputs::~RoverOutputs() = default;

@@ -190,7 +190,9 @@ void TopicApp::on_mcap_sample(std::uint16_t channel, RawSample&& bytes, std::uin
 void TopicApp::open_record_output() {
   const std::string& out = options_.out;
   if (ends_with(out, ".mcap")) {
-    mcap_ = value_or_throw(io::McapWriter::create(out), kExitRuntime);
+    io::McapWriterOptions mcap = options_.mcap;
+    mcap.chunk_size = static_cast<std::size_t>(options_.mcap_chunk_kib) * 1024U;
+    mcap_ = value_or_throw(io::McapWriter::create(out, mcap), kExitRuntime);
     return;
   }
   if (solutions_ && ends_with(out, ".pos")) {

@@ -7,6 +7,7 @@
 
 import fs from "node:fs";
 import { McapStreamReader } from "@mcap/core";
+import { decompressHandlers } from "./mcap_zstd.mjs";
 import { parseIDL } from "@foxglove/omgidl-parser";
 import { MessageReader } from "@foxglove/omgidl-serialization";
 import { check, failures } from "./check.mjs";
@@ -14,7 +15,7 @@ import { check, failures } from "./check.mjs";
 const [file, posFile, epochsText, ...topics] = process.argv.slice(2);
 const epochs = Number(epochsText);
 
-const reader = new McapStreamReader({ validateCrcs: true });
+const reader = new McapStreamReader({ validateCrcs: true, decompressHandlers });
 reader.append(fs.readFileSync(file));
 const schemas = new Map(), channels = new Map(), decoded = new Map(), kinds = new Map();
 for (let record; (record = reader.nextRecord()) !== undefined;) {

@@ -1,11 +1,13 @@
 // An MCAP file canyon did not write (written by @mcap/core's writer): the solutions of a canyon session plus a channel
-// of a type canyon does not know ("foo::msg::Bar" on "foo/bar"), for canyon play's bad-input test.
+// of a type canyon does not know ("foo::msg::Bar" on "foo/bar"), in @mcap/core's uncompressed chunks, for canyon play's
+// bad-input test.
 // Usage: node mcap_foreign.mjs SESSION.mcap OUT.mcap
 
 import fs from "node:fs";
 import { McapStreamReader, McapWriter } from "@mcap/core";
+import { decompressHandlers } from "./mcap_zstd.mjs";
 
-const reader = new McapStreamReader({ validateCrcs: true });
+const reader = new McapStreamReader({ validateCrcs: true, decompressHandlers });
 reader.append(fs.readFileSync(process.argv[2]));
 const chunks = [];
 let position = 0n;
@@ -14,7 +16,7 @@ const writer = new McapWriter({
     position: () => position,
     write: async (buffer) => { chunks.push(Buffer.from(buffer)); position += BigInt(buffer.byteLength); },
   },
-  useChunks: false,
+  useChunks: true,  // uncompressed chunks with Schema and Channel records inside, as @mcap/core writes them
 });
 await writer.start({ profile: "", library: "mcap_foreign.mjs" });
 const channels = new Map();

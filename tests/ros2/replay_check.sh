@@ -57,7 +57,9 @@ observations=canyon/observations  # the rover's epochs as ingested: the session 
 # Live. The VIO node publishes its whole run at once and stays up: its topics keep the last 1024 samples for readers
 # that join late (the rover), so the rover has the VIO from its first epoch whenever it starts; the base runs ahead of
 # the rover (pace 10 against 5), so every rover epoch has its base epoch.
-"$canyon" record "${inputs[@]}" "${outputs[@]}" "$observations" --out "$tmp/live.mcap" --domain "$domain" 2> "$tmp/live_rec.log" &
+# (live.mcap unchunked, --mcap-compression "": canyon's other layout; replay.mcap zstd chunks, the default)
+"$canyon" record "${inputs[@]}" "${outputs[@]}" "$observations" --out "$tmp/live.mcap" --mcap-compression "" \
+  --domain "$domain" 2> "$tmp/live_rec.log" &
 live_rec=$!
 pids+=("$live_rec")
 "$canyon" vio --vio "$tmp/sim/vio.csv" --timesync "$tmp/sim/timesync.csv" --pace 0 --wait-for-readers 1 --linger 120 \

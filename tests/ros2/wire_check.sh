@@ -3,8 +3,11 @@
 # DiagnosticArray on ROS 2's names (rt/canyon/fix, rt/canyon/odometry, rt/diagnostics) and type names; canyon_ros2_raw
 # takes the samples off the wire as raw bytes (no canyon IDL) with ROS 2's QoS profiles; wire_check.mjs decodes them
 # with independent ROS 2 decoders driven by the upstream .msg definitions and compares each with the rover's .pos.
-# canyon record writes the same session, every topic the rover publishes, to MCAP; mcap_check.mjs reads it with the
-# MCAP and OMG IDL packages of the npm registry, decodes every message and compares the solutions with the .pos.
+# canyon record writes the same session, every topic the rover publishes, to MCAP (zstd chunks): mcap_check.mjs reads
+# it with the MCAP and OMG IDL packages of the npm registry, decodes every message and compares the solutions with the
+# .pos; mcap_indexed.mjs reads it through its indexes, as Foxglove does. Then canyon play (round trip, bad input), the
+# rover's VIO from ROS 2 Odometry (independently encoded, and from canyon vio --ros2), canyon base's rt/rtcm
+# (rtcm_msgs/msg/Message), and bad Odometry.
 # Usage: tests/ros2/wire_check.sh BUILD_DIR
 # Exit 0 pass, 1 fail, 77 (SKIP:) no npm or the npm registry unreachable for the decoders.
 set -euo pipefail
@@ -46,7 +49,7 @@ estimator:
   out: $tmp/rover.pos
 rover_id: walker
 input: {pace: 5}
-dds: {domain: $domain}
+dds: {domain: $domain, record: $tmp/inproc.mcap}
 ros2: {enabled: true}
 EOF
 record() {  # topic type qos file count (0: until 5 s without a sample)
@@ -70,6 +73,10 @@ node "$decoders/wire_check.mjs" "$tmp"
 wait "$mcap_pid" || { echo "FAIL: canyon record to MCAP: $(cat "$tmp/mcap.log")"; exit 1; }
 cat "$tmp/mcap.log"
 node "$decoders/mcap_check.mjs" "$tmp/session.mcap" "$tmp/rover.pos" "$epochs" "${session_topics[@]}"
+node "$decoders/mcap_indexed.mjs" "$tmp/session.mcap" "$(grep -o '[0-9]* samples' "$tmp/mcap.log" | cut -d' ' -f1)"
+# The rover's own in-process recording (dds.record) holds the same samples as canyon record took off the wire.
+node "$decoders/mcap_same.mjs" "$tmp/session.mcap" "$tmp/inproc.mcap" "dds.record (in-process) against canyon record" \
+  --decoded
 # Bad input to canyon record: a topic it has no schema for, several topics without MCAP, an MCAP path that cannot be
 # written: each a clear error, nothing started.
 expect_error() {  # exit-code message args...

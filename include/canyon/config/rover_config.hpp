@@ -67,6 +67,7 @@ struct RoverConfig {
   std::string timesync_topic = "canyon/timesync";  ///< canyon::msg::TimeSyncSample in (input.vio dds)
   bool publish_stages = true;         ///< also canyon/bridged, canyon/alignment, canyon/prior, canyon/float
   bool publish_observations = false;  ///< also canyon/observations: the rover's epochs as ingested
+  std::string record;                 ///< MCAP: every topic this rover publishes, recorded in-process; "": none
   Ros2Options ros2;
 
   /// Empty if usable, else the first broken rule.

@@ -15,6 +15,7 @@
 #include <mutex>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <fastcdr/exceptions/Exception.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -32,6 +33,7 @@
 
 #include "canyon/core/result.hpp"
 #include "canyon/dds/profiles.hpp"
+#include "canyon/dds/session_recorder.hpp"
 
 namespace canyon::dds {
 
@@ -104,8 +106,18 @@ class DdsWriter {
   DdsWriter(const DdsWriter&) = delete;
   DdsWriter& operator=(const DdsWriter&) = delete;
 
-  /// Publishes a sample; false if Fast DDS refused it (history full past max_blocking_time).
-  bool write(Msg& sample) { return writer_->write(&sample); }
+  /// Publishes a sample; false if Fast DDS refused it (history full past max_blocking_time). With record_to(), the
+  /// sample is recorded too.
+  bool write(Msg& sample) {
+    const bool written = writer_->write(&sample);
+    if (recorder_ != nullptr) record(sample);
+    return written;
+  }
+  /// Also records every sample written from now on, serialized as on the wire, to `recorder` on `channel`.
+  void record_to(SessionRecorder& recorder, std::uint16_t channel) {
+    recorder_ = &recorder;
+    channel_ = channel;
+  }
   /// Readers matched now.
   [[nodiscard]] int matched() const { return listener_.matched.load(); }
   /// Waits until every matched reader acknowledged every sample (reliable), at most `timeout_s`.
@@ -124,10 +136,24 @@ class DdsWriter {
     std::atomic<int> matched{0};
   };
   explicit DdsWriter(DdsParticipant& participant) : participant_(participant) {}
+  void record(Msg& sample) {
+    const std::int64_t start = thread_cpu_ns();
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(type_.getSerializedSizeProvider(&sample)());
+    if (type_.serialize(&sample, &payload)) {
+      // On the wire the payload is padded with zeros to a multiple of 4 bytes: record the same bytes.
+      std::vector<std::uint8_t> bytes(payload.data, payload.data + payload.length);
+      bytes.resize((bytes.size() + 3U) / 4U * 4U, 0);
+      recorder_->record(channel_, std::move(bytes));
+    }
+    recorder_->add_cpu_ns(thread_cpu_ns() - start);
+  }
   DdsParticipant& participant_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::DataWriter* writer_ = nullptr;
   Listener listener_;
+  PubSub type_;                          ///< serializes the samples record() takes
+  SessionRecorder* recorder_ = nullptr;  ///< record_to(); not owned
+  std::uint16_t channel_ = 0;
 };
 
 /// A reader of samples of type Msg from a data_reader profile; every sample taken goes to `on_sample`.

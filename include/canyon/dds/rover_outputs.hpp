@@ -51,6 +51,9 @@ class RoverOutputs {
 
   /// Closes the .pos, if any (a write error that happened on the way).
   Status close_pos();
+  /// Closes the in-process recording (dds.record), if any, and logs what it held and cost: its thread CPU time against
+  /// `process_cpu_s`, the rover's; a write error that happened on the way.
+  Status close_record(double process_cpu_s);
   /// Readers matched now of the solution topic and, with ros2.enabled, of the three ROS 2 topics, counted together.
   [[nodiscard]] int solution_readers() const {
     int readers = solution_->matched();
@@ -72,6 +75,9 @@ class RoverOutputs {
   void update_context(const pipeline::SolvedEpoch& item);
   /// The ROS 2 messages of the epoch: NavSatFix written now, Odometry and DiagnosticArray pending.
   void take_solved_ros2(const pipeline::SolvedEpoch& item);
+  void start_recording(const config::RoverConfig& config);
+  template <typename Writer>
+  void record(Writer* writer, const std::string& topic);
 
   std::string rover_id_;
   std::unique_ptr<SolutionWriter> solution_;
@@ -81,6 +87,7 @@ class RoverOutputs {
   std::unique_ptr<PriorWriter> prior_;
   std::unique_ptr<FloatWriter> float_;
   std::unique_ptr<ObservationWriter> observations_;  ///< dds.publish_observations only
+  std::unique_ptr<SessionRecorder> recorder_;        ///< dds.record only
   std::uint64_t observations_sent_ = 0;
   config::Ros2Options ros2_;
   core::LeapSecondTable leaps_;

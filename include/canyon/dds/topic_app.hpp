@@ -47,6 +47,8 @@ struct TopicOptions {
   std::string topic;                               ///< record, echo: canyon/solution, canyon/rtcm, ... (by suffix)
   std::vector<std::string> more_topics;            ///< record to .mcap: the other topics of the session
   std::string out;                                 ///< record: .pos, .nmea, .csv, .rtcm3, .mcap or another text file
+  io::McapWriterOptions mcap;                      ///< record to .mcap: compression (chunk_size from mcap_chunk_kib)
+  int mcap_chunk_kib = 256;                        ///< record to .mcap: uncompressed KiB per chunk
   int domain = 0;                                  ///< DDS domain id
   std::string profiles;                            ///< deployment profile file on top of the shipped QoS; "": none
   std::int64_t count = 0;                          ///< stop after this many samples; 0: no limit

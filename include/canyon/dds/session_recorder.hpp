@@ -1,0 +1,59 @@
+#pragma once
+// In-process MCAP recording of what a program publishes (canyon rover dds.record): each sample its DdsWriter writes
+// is serialized with the writer's own type support (the same CDR bytes as on the wire, encapsulation header
+// included) and written to the session on the writer's thread, with the channel's schema as canyon record writes it
+// (raw_samples.hpp, recorded_topic). No DDS reader and no second process: what recording costs is the serialization
+// and the file (measured: the thread CPU time spent here, reported by cpu_ns()).
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "canyon/core/result.hpp"
+#include "canyon/io/mcap.hpp"
+
+namespace canyon::dds {
+
+class SessionRecorder {
+ public:
+  /// Creates the MCAP file (options: compression and chunk size); Error naming it.
+  static Result<std::unique_ptr<SessionRecorder>> create(const std::string& path, const io::McapWriterOptions& options);
+  SessionRecorder(const SessionRecorder&) = delete;
+  SessionRecorder& operator=(const SessionRecorder&) = delete;
+  ~SessionRecorder() = default;
+
+  /// The channel of `topic` (its type and schema by recorded_topic()); Error for a topic canyon does not know.
+  Result<std::uint16_t> channel(const std::string& topic);
+  /// One sample's serialized bytes on `channel`, stamped now. Thread-safe; a write error is kept for close().
+  void record(std::uint16_t channel, std::vector<std::uint8_t> bytes);
+  /// Adds `ns` of thread CPU time to what recording cost (the writers time their serialization and record()).
+  void add_cpu_ns(std::int64_t ns) { cpu_ns_.fetch_add(ns); }
+  /// Writes the summary and closes the file; the first write error, if any.
+  Status close();
+
+  [[nodiscard]] std::uint64_t messages() const;
+  [[nodiscard]] std::uint64_t bytes() const;
+  [[nodiscard]] std::int64_t cpu_ns() const { return cpu_ns_.load(); }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  SessionRecorder(io::McapWriter writer, std::string path) : writer_(std::move(writer)), path_(std::move(path)) {}
+
+  mutable std::mutex mutex_;
+  io::McapWriter writer_;
+  std::string path_;
+  std::vector<std::uint32_t> sequences_;          ///< per channel id
+  std::map<std::string, std::uint16_t> schemas_;  ///< schema id per type name (each schema written once)
+  Status status_ = Ok{};
+  bool closed_ = false;
+  std::atomic<std::int64_t> cpu_ns_{0};
+};
+
+/// The calling thread's CPU time (ns).
+[[nodiscard]] std::int64_t thread_cpu_ns();
+
+}  // namespace canyon::dds
