@@ -59,7 +59,10 @@ PlayApp::PlayApp(PlayOptions options) : options_(std::move(options)) {
       continue;
     }
     const auto schema = session_.schemas.find(channel.schema_id);
-    const auto known = recorded_topic(channel.topic);
+    auto known = recorded_topic(channel.topic);
+    if (schema != session_.schemas.end() && (!known || known->type_name != schema->second.name)) {
+      known = recorded_type(schema->second.name);  // a topic renamed (ros2.fix_topic: gps/navsat), a type canyon has
+    }
     if (schema == session_.schemas.end() || schema->second.encoding != "omgidl" || channel.message_encoding != "cdr" ||
         !known || known->type_name != schema->second.name) {
       spdlog::warn("{}: channel {} ('{}', schema '{}') is not one canyon knows: left out", options_.session, id,

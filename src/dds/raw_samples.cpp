@@ -3,6 +3,7 @@
 #include "canyon/dds/raw_samples.hpp"
 
 #include <cstring>
+#include <span>
 #include <utility>
 
 #include "canyon/dds/profiles.hpp"
@@ -57,41 +58,55 @@ bool RawSampleType::getKey(void* /*data*/, eprosima::fastrtps::rtps::InstanceHan
   return false;
 }
 
+namespace {
+
+/// The topics canyon records, by the suffix of their name, with their type and QoS.
+struct Known {
+  const char* suffix;
+  const char* type;
+  const char* profile;
+  const char* writer;
+};
+constexpr Known kCanyonTopics[] = {
+    {"solution", "canyon::msg::Solution", profile::kSolutionReader, profile::kSolutionWriter},
+    {"timing", "canyon::msg::StageTiming", profile::kTimingReader, profile::kTimingWriter},
+    {"rtcm", "canyon::msg::RtcmFrame", profile::kRtcmReader, profile::kRtcmWriter},
+    {"bridged", "canyon::msg::BridgedEpoch", profile::kStageReader, profile::kStageWriter},
+    {"prior", "canyon::msg::Prior", profile::kStageReader, profile::kStageWriter},
+    {"float", "canyon::msg::FloatSolution", profile::kStageReader, profile::kStageWriter},
+    {"alignment", "canyon::msg::Alignment", profile::kStageReader, profile::kStageWriter},
+    {"vio", "canyon::msg::VioPose", profile::kVioReader, profile::kVioWriter},
+    {"timesync", "canyon::msg::TimeSyncSample", profile::kVioReader, profile::kVioWriter},
+    {"observations", "canyon::msg::GnssObservationEpoch", profile::kStageReader, profile::kStageWriter},
+};
+constexpr Known kRos2Topics[] = {
+    {"fix", "sensor_msgs::msg::dds_::NavSatFix_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
+    {"odometry", "nav_msgs::msg::dds_::Odometry_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
+    {"diagnostics", "diagnostic_msgs::msg::dds_::DiagnosticArray_", profile::kRos2DefaultReader,
+     profile::kRos2DefaultWriter},
+    {"rtcm", "rtcm_msgs::msg::dds_::Message_", profile::kRos2DefaultReader, profile::kRos2StreamWriter},
+};
+
+RecordedTopic recorded(const Known& k, bool ros2) {
+  return RecordedTopic{k.type, ros2 ? msgs::idl_text("Ros2Messages.idl") : canyon_schema(), k.profile, k.writer};
+}
+
+}  // namespace
+
 std::optional<RecordedTopic> recorded_topic(const std::string& topic) {
-  struct Known {
-    const char* suffix;
-    const char* type;
-    const char* profile;
-    const char* writer;
-  };
-  static const Known kCanyon[] = {
-      {"solution", "canyon::msg::Solution", profile::kSolutionReader, profile::kSolutionWriter},
-      {"timing", "canyon::msg::StageTiming", profile::kTimingReader, profile::kTimingWriter},
-      {"rtcm", "canyon::msg::RtcmFrame", profile::kRtcmReader, profile::kRtcmWriter},
-      {"bridged", "canyon::msg::BridgedEpoch", profile::kStageReader, profile::kStageWriter},
-      {"prior", "canyon::msg::Prior", profile::kStageReader, profile::kStageWriter},
-      {"float", "canyon::msg::FloatSolution", profile::kStageReader, profile::kStageWriter},
-      {"alignment", "canyon::msg::Alignment", profile::kStageReader, profile::kStageWriter},
-      {"vio", "canyon::msg::VioPose", profile::kVioReader, profile::kVioWriter},
-      {"timesync", "canyon::msg::TimeSyncSample", profile::kVioReader, profile::kVioWriter},
-      {"observations", "canyon::msg::GnssObservationEpoch", profile::kStageReader, profile::kStageWriter},
-  };
-  static const Known kRos2[] = {
-      {"fix", "sensor_msgs::msg::dds_::NavSatFix_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
-      {"odometry", "nav_msgs::msg::dds_::Odometry_", profile::kRos2SensorDataReader, profile::kRos2SensorDataWriter},
-      {"diagnostics", "diagnostic_msgs::msg::dds_::DiagnosticArray_", profile::kRos2DefaultReader,
-       profile::kRos2DefaultWriter},
-      {"rtcm", "rtcm_msgs::msg::dds_::Message_", profile::kRos2DefaultReader, profile::kRos2StreamWriter},
-  };
-  if (topic.rfind("rt/", 0) == 0) {
-    for (const Known& k : kRos2) {
-      if (ends_with(topic, k.suffix))
-        return RecordedTopic{k.type, msgs::idl_text("Ros2Messages.idl"), k.profile, k.writer};
-    }
-    return std::nullopt;
+  const bool ros2 = topic.rfind("rt/", 0) == 0;
+  for (const Known& k : ros2 ? std::span<const Known>(kRos2Topics) : std::span<const Known>(kCanyonTopics)) {
+    if (ends_with(topic, k.suffix)) return recorded(k, ros2);
   }
-  for (const Known& k : kCanyon) {
-    if (ends_with(topic, k.suffix)) return RecordedTopic{k.type, canyon_schema(), k.profile, k.writer};
+  return std::nullopt;
+}
+
+std::optional<RecordedTopic> recorded_type(const std::string& type_name) {
+  for (const Known& k : kCanyonTopics) {
+    if (type_name == k.type) return recorded(k, false);
+  }
+  for (const Known& k : kRos2Topics) {
+    if (type_name == k.type) return recorded(k, true);
   }
   return std::nullopt;
 }

@@ -63,7 +63,7 @@ RoverOutputs::RoverOutputs(DdsParticipant& participant, const config::RoverConfi
 template <typename Writer>
 void RoverOutputs::record(Writer* writer, const std::string& topic) {
   if (writer == nullptr) return;
-  writer->record_to(*recorder_, value_or_throw(recorder_->channel(topic), kExitRuntime));
+  writer->record_to(*recorder_, value_or_throw(recorder_->channel(topic, writer->type_name()), kExitRuntime));
 }
 
 void RoverOutputs::start_recording(const config::RoverConfig& config) {

@@ -24,15 +24,15 @@ Result<std::unique_ptr<SessionRecorder>> SessionRecorder::create(const std::stri
   return std::unique_ptr<SessionRecorder>(new SessionRecorder(std::move(*writer), path));
 }
 
-Result<std::uint16_t> SessionRecorder::channel(const std::string& topic) {
-  const auto known = recorded_topic(topic);
-  if (!known) return Error{"cannot record topic '" + topic + "': not one canyon knows", path_, 0};
+Result<std::uint16_t> SessionRecorder::channel(const std::string& topic, const std::string& type_name) {
+  const auto known = recorded_type(type_name);
+  if (!known) return Error{"cannot record topic '" + topic + "': no IDL of its type " + type_name, path_, 0};
   const std::lock_guard lock(mutex_);
-  auto schema = schemas_.find(known->type_name);
+  auto schema = schemas_.find(type_name);
   if (schema == schemas_.end()) {
-    auto added = writer_.add_schema(known->type_name, "omgidl", known->schema);
+    auto added = writer_.add_schema(type_name, "omgidl", known->schema);
     if (!added) return added.error();
-    schema = schemas_.emplace(known->type_name, *added).first;
+    schema = schemas_.emplace(type_name, *added).first;
   }
   auto id = writer_.add_channel(schema->second, topic, "cdr");
   if (!id) return id.error();

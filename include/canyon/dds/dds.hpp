@@ -120,6 +120,8 @@ class DdsWriter {
   }
   /// Readers matched now.
   [[nodiscard]] int matched() const { return listener_.matched.load(); }
+  /// The DDS type name of the samples ("canyon::msg::Solution", "sensor_msgs::msg::dds_::NavSatFix_").
+  [[nodiscard]] std::string type_name() const { return type_.getName(); }
   /// Waits until every matched reader acknowledged every sample (reliable), at most `timeout_s`.
   bool wait_for_acknowledgments(double timeout_s) {
     const auto seconds = static_cast<std::int32_t>(timeout_s);

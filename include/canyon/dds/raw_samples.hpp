@@ -44,4 +44,8 @@ struct RecordedTopic {
 /// ROS 2 types canyon publishes); nullopt for a topic canyon does not know.
 [[nodiscard]] std::optional<RecordedTopic> recorded_topic(const std::string& topic);
 
+/// What recording and playing a topic of DDS type `type_name` takes (a topic renamed beyond the suffixes above);
+/// nullopt for a type canyon does not publish.
+[[nodiscard]] std::optional<RecordedTopic> recorded_type(const std::string& type_name);
+
 }  // namespace canyon::dds

@@ -2,8 +2,9 @@
 // In-process MCAP recording of what a program publishes (canyon rover dds.record): each sample its DdsWriter writes
 // is serialized with the writer's own type support (the same CDR bytes as on the wire, encapsulation header
 // included) and written to the session on the writer's thread, with the channel's schema as canyon record writes it
-// (raw_samples.hpp, recorded_topic). No DDS reader and no second process: what recording costs is the serialization
-// and the file (measured: the thread CPU time spent here, reported by cpu_ns()).
+// (raw_samples.hpp, recorded_type: by the writer's type, so renamed topics are recorded too). No DDS reader and no
+// second process: what recording costs is the serialization and the file (measured: the thread CPU time spent here,
+// reported by cpu_ns()).
 
 #include <atomic>
 #include <cstdint>
@@ -26,8 +27,9 @@ class SessionRecorder {
   SessionRecorder& operator=(const SessionRecorder&) = delete;
   ~SessionRecorder() = default;
 
-  /// The channel of `topic` (its type and schema by recorded_topic()); Error for a topic canyon does not know.
-  Result<std::uint16_t> channel(const std::string& topic);
+  /// The channel of `topic`, whose samples are of DDS type `type_name` (its schema by recorded_type()); Error for a
+  /// type canyon does not publish.
+  Result<std::uint16_t> channel(const std::string& topic, const std::string& type_name);
   /// One sample's serialized bytes on `channel`, stamped now. Thread-safe; a write error is kept for close().
   void record(std::uint16_t channel, std::vector<std::uint8_t> bytes);
   /// Adds `ns` of thread CPU time to what recording cost (the writers time their serialization and record()).
