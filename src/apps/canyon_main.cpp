@@ -131,7 +131,8 @@ void add_process_command(CLI::App& app, ProcessArgs& args) {
   cmd->add_option("--session", args.session,
                   "A session recorded by canyon record (SESSION.mcap) as the input: the rover's epochs "
                   "(canyon/observations), the base's RTCM 3 (canyon/rtcm) and its ephemerides unless --nav is given, "
-                  "the VIO (canyon/vio, canyon/timesync); runs canyon-play --extract")
+                  "the VIO (canyon/vio, canyon/timesync), each unless given (--base BASE.obs ...); runs "
+                  "canyon-play --extract")
       ->check(CLI::ExistingFile);
   cmd->add_option("--session-dir", args.session_dir,
                   "--session: write the extracted inputs into this folder and keep them (default: a temporary one)");
@@ -244,14 +245,13 @@ std::optional<int> build_process_config(const ProcessArgs& args, canyon::config:
 std::string sibling_program(const std::string& command);
 
 /// --session: the session's rover inputs written into `dir` by canyon-play --extract (the DDS side decodes the
-/// recorded messages), and `args` pointed at them. An exit status when that fails.
-std::optional<int> take_session_inputs(ProcessArgs& args, const std::string& dir) {
-  if (!args.rover.empty() || !args.base.empty() || !args.vio.empty() || !args.timesync.empty()) {
-    std::cerr << "canyon: error: --session gives the inputs: leave out --rover, --base, --vio and --timesync\n";
-    return kExitUsage;
-  }
+/// recorded messages), and `args` pointed at those the command line does not give (--base BASE.obs with a session
+/// recorded without the base's RTCM, say); the VIO only in fusion mode. An exit status when that fails.
+std::optional<int> take_session_inputs(ProcessArgs& args, const canyon::config::ProcessConfig& config,
+                                       const std::string& dir) {
   const std::string program = sibling_program("play");
   std::vector<std::string> words{program, "--extract", dir, args.session};
+  if (args.quiet) words.emplace_back("-q");
   std::vector<char*> argv;
   argv.reserve(words.size() + 1);
   for (std::string& w : words) argv.push_back(w.data());
@@ -269,10 +269,15 @@ std::optional<int> take_session_inputs(ProcessArgs& args, const std::string& dir
     const std::string path = dir + "/" + name;
     return access(path.c_str(), R_OK) == 0 ? path : std::string();
   };
-  args.rover = in_dir("rover.obs");
-  args.base = in_dir("base.rtcm3");
-  args.vio = in_dir("vio.csv");
-  args.timesync = in_dir("timesync.csv");
+  const auto fill = [](std::string& given, const std::string& extracted) {
+    if (given.empty()) given = extracted;
+  };
+  fill(args.rover, in_dir("rover.obs"));
+  if (config.mode != canyon::config::ProcessMode::Spp) fill(args.base, in_dir("base.rtcm3"));
+  if (config.mode == canyon::config::ProcessMode::Fusion) {
+    fill(args.vio, in_dir("vio.csv"));
+    fill(args.timesync, in_dir("timesync.csv"));
+  }
   if (args.nav.empty() && !in_dir("nav.rnx").empty()) args.nav.push_back(in_dir("nav.rnx"));
   return std::nullopt;
 }
@@ -291,7 +296,10 @@ int run_process_command(const ProcessArgs& given) {
     }
     dir = pattern;
   }
-  std::optional<int> failed = take_session_inputs(args, dir);
+  // The mode decides which of the session's inputs are used: the configuration as the command line and file give it.
+  canyon::config::ProcessConfig mode_config;
+  std::optional<int> failed = build_process_config(args, mode_config);
+  if (!failed) failed = take_session_inputs(args, mode_config, dir);
   const int status = failed ? *failed : run_process_files(args);
   if (args.session_dir.empty()) {
     std::error_code ignored;

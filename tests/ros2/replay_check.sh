@@ -111,6 +111,14 @@ if ! cmp -s <(grep -v '^%' "$tmp/live.pos") <(grep -v '^%' "$tmp/processed.pos")
   exit 1
 fi
 echo "canyon process --session live.mcap: the same $(grep -vc '^%' "$tmp/processed.pos") solutions as the live rover"
+# An input given on the command line wins over the session's: rtk with the base's RINEX file equals rtk on the files.
+"$canyon" process --session "$tmp/live.mcap" --mode rtk --base "$tmp/sim/base.obs" --nav "$tmp/sim/nav.rnx" \
+  --out "$tmp/session_rtk.pos" -q
+"$canyon" process --mode rtk --rover "$tmp/sim/rover.obs" --base "$tmp/sim/base.obs" --nav "$tmp/sim/nav.rnx" \
+  --out "$tmp/files_rtk.pos" -q
+cmp -s <(grep -v '^%' "$tmp/session_rtk.pos") <(grep -v '^%' "$tmp/files_rtk.pos") ||
+  { echo "FAIL: canyon process --session --mode rtk --base BASE.obs differs from rtk on the files"; exit 1; }
+echo "canyon process --session --mode rtk --base BASE.obs: the same solutions as rtk on the rover's and base's files"
 rc=0
 "$canyon" process --session "$tmp/replay.mcap" --config "$tmp/process.yaml" --out "$tmp/x.pos" > "$tmp/bad.log" 2>&1 || rc=$?
 [[ $rc -ne 0 ]] && grep -qF "no rover observations (canyon/observations" "$tmp/bad.log" ||
