@@ -24,12 +24,16 @@ constexpr std::int64_t kGpsEpochPosixS = 315964800;  // 1980-01-06 00:00:00 UTC
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr const char* kStageNames[6] = {"ingest", "time_bridge", "alignment", "prediction", "update", "ambiguity"};
 
-std_msgs::msg::dds_::Header_ header(const core::GpsTime& t, const std::string& frame_id,
-                                    const core::LeapSecondTable& leaps) {
+std_msgs::msg::dds_::Header_ header(const builtin_interfaces::msg::dds_::Time_& stamp, const std::string& frame_id) {
   std_msgs::msg::dds_::Header_ h;
-  h.stamp(ros_time(t, leaps));
+  h.stamp(stamp);
   h.frame_id(frame_id);
   return h;
+}
+
+std_msgs::msg::dds_::Header_ header(const core::GpsTime& t, const std::string& frame_id,
+                                    const core::LeapSecondTable& leaps) {
+  return header(ros_time(t, leaps), frame_id);
 }
 
 /// Row-major copy of a matrix into a ROS covariance array.
@@ -159,16 +163,12 @@ nav_msgs::msg::dds_::Odometry_ to_ros2_odometry(const io::VioRecord& record, con
                                                 const std::string& child_frame_id, const core::LeapSecondTable& leaps) {
   constexpr std::int64_t kNsPerS = 1000000000;
   const std::int64_t gps_s = record.t_ns / kNsPerS;
-  const core::GpsTime whole{static_cast<int>(gps_s / core::kSecondsPerWeek),
-                            static_cast<double>(gps_s % core::kSecondsPerWeek)};
-  builtin_interfaces::msg::dds_::Time_ stamp;
-  stamp.sec(static_cast<std::int32_t>(kGpsEpochPosixS + gps_s - leaps.gps_minus_utc_at_gps(whole)));
-  stamp.nanosec(static_cast<std::uint32_t>(record.t_ns % kNsPerS));
+  // ros_time() rounds the time of week to the nanosecond: exact for a week's seconds (double: 1e-10 s at 604,800 s).
+  const core::GpsTime t{
+      static_cast<int>(gps_s / core::kSecondsPerWeek),
+      static_cast<double>(gps_s % core::kSecondsPerWeek) + 1e-9 * static_cast<double>(record.t_ns % kNsPerS)};
   nav_msgs::msg::dds_::Odometry_ odometry;
-  std_msgs::msg::dds_::Header_ h;
-  h.stamp(stamp);
-  h.frame_id(frame_id);
-  odometry.header(h);
+  odometry.header(header(t, frame_id, leaps));
   odometry.child_frame_id(child_frame_id);
   geometry_msgs::msg::dds_::PoseWithCovariance_ pose;
   pose.pose().position().x(record.T_OI.p.x());
@@ -190,10 +190,7 @@ rtcm_msgs::msg::dds_::Message_ to_ros2_rtcm(const std::vector<std::uint8_t>& fra
                                             const builtin_interfaces::msg::dds_::Time_& sent,
                                             const std::string& frame_id) {
   rtcm_msgs::msg::dds_::Message_ message;
-  std_msgs::msg::dds_::Header_ h;
-  h.stamp(sent);
-  h.frame_id(frame_id);
-  message.header(h);
+  message.header(header(sent, frame_id));
   message.message(frame);
   return message;
 }

@@ -51,49 +51,34 @@ struct Taken {
 
 struct SessionInputs {
   Taken<core::ObsEpoch> observations;
-  Taken<std::vector<std::uint8_t>> rtcm;
+  Taken<base::BaseFrame> rtcm;
   Taken<io::VioRecord> vio;
   Taken<io::TimeSyncPair> timesync;
 };
 
+/// A recorded message decoded, taken once (by its `sequence`) and converted by its from_msg; refusals counted.
+template <typename Msg, typename PubSub, typename T, typename Sequence>
+void take_one(const io::McapMessage& m, Taken<T>& taken, Sequence sequence) {
+  Msg message;
+  if (!decode<Msg, PubSub>(m.data, message)) return taken.refuse("a message that does not decode");
+  if (!taken.sequences.insert(static_cast<std::uint64_t>(sequence(message))).second) return;
+  auto record = from_msg(message);
+  if (!record) return taken.refuse(record.error().to_string());
+  taken.records.push_back(std::move(*record));
+}
+
 void take(const std::string& topic, const io::McapMessage& m, SessionInputs& in) {
   if (topic.rfind("rt/", 0) == 0) return;  // ROS 2 topics hold outputs only
+  const auto by_number = [](const auto& message) { return message.sequence_number(); };
   if (ends_with(topic, "observations")) {
-    msg::GnssObservationEpoch message;
-    if (!decode<msg::GnssObservationEpoch, msg::GnssObservationEpochPubSubType>(m.data, message)) {
-      return in.observations.refuse("a message that does not decode");
-    }
-    if (!in.observations.sequences.insert(message.sequence_number()).second) return;
-    auto epoch = from_msg(message);
-    if (!epoch) return in.observations.refuse(epoch.error().to_string());
-    in.observations.records.push_back(std::move(*epoch));
+    take_one<msg::GnssObservationEpoch, msg::GnssObservationEpochPubSubType>(m, in.observations, by_number);
   } else if (ends_with(topic, "rtcm")) {
-    msg::RtcmFrame message;
-    if (!decode<msg::RtcmFrame, msg::RtcmFramePubSubType>(m.data, message)) {
-      return in.rtcm.refuse("a message that does not decode");
-    }
-    if (!in.rtcm.sequences.insert(message.sequence_number()).second) return;
-    auto frame = from_msg(message);
-    if (!frame) return in.rtcm.refuse(frame.error().to_string());
-    in.rtcm.records.push_back(std::move(frame->bytes));
+    take_one<msg::RtcmFrame, msg::RtcmFramePubSubType>(m, in.rtcm, by_number);
   } else if (ends_with(topic, "vio")) {
-    msg::VioPose message;
-    if (!decode<msg::VioPose, msg::VioPosePubSubType>(m.data, message)) {
-      return in.vio.refuse("a message that does not decode");
-    }
-    if (!in.vio.sequences.insert(message.sequence_number()).second) return;
-    auto pose = from_msg(message);
-    if (!pose) return in.vio.refuse(pose.error().to_string());
-    in.vio.records.push_back(std::move(*pose));
+    take_one<msg::VioPose, msg::VioPosePubSubType>(m, in.vio, by_number);
   } else if (ends_with(topic, "timesync")) {
-    msg::TimeSyncSample message;
-    if (!decode<msg::TimeSyncSample, msg::TimeSyncSamplePubSubType>(m.data, message)) {
-      return in.timesync.refuse("a message that does not decode");
-    }
-    if (!in.timesync.sequences.insert(static_cast<std::uint64_t>(message.device_time_ns())).second) return;
-    auto pair = from_msg(message);
-    if (!pair) return in.timesync.refuse(pair.error().to_string());
-    in.timesync.records.push_back(*pair);
+    take_one<msg::TimeSyncSample, msg::TimeSyncSamplePubSubType>(
+        m, in.timesync, [](const msg::TimeSyncSample& pair) { return pair.device_time_ns(); });
   }
 }
 
@@ -123,7 +108,7 @@ Status write_rover(const std::vector<core::ObsEpoch>& epochs, const std::string&
 }
 
 /// The frames as one stream, and the ephemerides in them (RINEX navigation) when there are any.
-Status write_base(const std::vector<std::vector<std::uint8_t>>& frames, const std::optional<core::GpsTime>& reference,
+Status write_base(const std::vector<base::BaseFrame>& frames, const std::optional<core::GpsTime>& reference,
                   SessionFiles& files, const std::string& dir) {
   files.base_rtcm = dir + "/base.rtcm3";
   std::ofstream out(files.base_rtcm, std::ios::binary | std::ios::trunc);
@@ -131,9 +116,9 @@ Status write_base(const std::vector<std::vector<std::uint8_t>>& frames, const st
   options.format = io::StreamFormat::Rtcm3;
   if (reference) options.rtcm3.reference_time = *reference;
   io::GnssStreamDecoder decoder(options);
-  for (const auto& frame : frames) {
-    out.write(reinterpret_cast<const char*>(frame.data()), static_cast<std::streamsize>(frame.size()));
-    decoder.push(frame);
+  for (const base::BaseFrame& frame : frames) {
+    out.write(reinterpret_cast<const char*>(frame.bytes.data()), static_cast<std::streamsize>(frame.bytes.size()));
+    decoder.push(frame.bytes);
   }
   out.close();
   if (!out) return Error{"cannot write the file", files.base_rtcm, 0};

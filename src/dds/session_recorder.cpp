@@ -40,18 +40,19 @@ Result<std::uint16_t> SessionRecorder::channel(const std::string& topic, const s
   return *id;
 }
 
-void SessionRecorder::record(std::uint16_t channel, std::vector<std::uint8_t> bytes) {
+Status SessionRecorder::record(std::uint16_t channel, std::vector<std::uint8_t> bytes, std::uint64_t publish_time_ns) {
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   const auto ns = static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count());
   const std::lock_guard lock(mutex_);
-  if (closed_ || !status_ || channel >= sequences_.size()) return;
+  if (closed_ || !status_ || channel >= sequences_.size()) return status_;
   io::McapMessage m;
   m.channel_id = channel;
   m.sequence = sequences_[channel]++;
   m.log_time_ns = ns;
-  m.publish_time_ns = ns;
+  m.publish_time_ns = publish_time_ns != 0 ? publish_time_ns : ns;
   m.data = std::move(bytes);
   status_ = writer_.write(m);
+  return status_;
 }
 
 Status SessionRecorder::close() {

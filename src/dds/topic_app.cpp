@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
-#include <map>
 #include <thread>
 #include <utility>
 
@@ -144,16 +143,9 @@ std::vector<std::string> TopicApp::mcap_topics() const {
 }
 
 void TopicApp::create_mcap_readers() {
-  std::map<std::string, std::uint16_t> schemas;  // by type name
   for (const std::string& topic : mcap_topics()) {
     const RecordedTopic recorded = *recorded_topic(topic);
-    if (schemas.count(recorded.type_name) == 0) {
-      schemas[recorded.type_name] =
-          value_or_throw(mcap_->add_schema(recorded.type_name, "omgidl", recorded.schema), kExitRuntime);
-    }
-    const std::uint16_t channel =
-        value_or_throw(mcap_->add_channel(schemas[recorded.type_name], topic, "cdr"), kExitRuntime);
-    mcap_sequence_.push_back(0);
+    const std::uint16_t channel = value_or_throw(mcap_->channel(topic, recorded.type_name), kExitRuntime);
     auto dds_topic = value_or_throw(
         participant_->topic(topic, fdds::TypeSupport(new RawSampleType(recorded.type_name))), kExitRuntime);
     auto holder = std::make_unique<McapReader>(*this, channel);
@@ -169,17 +161,8 @@ void TopicApp::create_mcap_readers() {
 }
 
 void TopicApp::on_mcap_sample(std::uint16_t channel, RawSample&& bytes, std::uint64_t publish_time_ns) {
-  const auto log_ns = static_cast<std::uint64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-          .count());
-  const std::lock_guard lock(mutex_);
-  io::McapMessage m;
-  m.channel_id = channel;
-  m.sequence = mcap_sequence_[channel]++;
-  m.log_time_ns = log_ns;
-  m.publish_time_ns = publish_time_ns;
-  m.data = std::move(bytes);
-  if (Status s = mcap_->write(m); !s) {
+  if (Status s = mcap_->record(channel, std::move(bytes), publish_time_ns); !s) {
+    const std::lock_guard lock(mutex_);
     note_error(s.error().to_string());
     stop();
     return;
@@ -192,7 +175,7 @@ void TopicApp::open_record_output() {
   if (ends_with(out, ".mcap")) {
     io::McapWriterOptions mcap = options_.mcap;
     mcap.chunk_size = static_cast<std::size_t>(options_.mcap_chunk_kib) * 1024U;
-    mcap_ = value_or_throw(io::McapWriter::create(out, mcap), kExitRuntime);
+    mcap_ = value_or_throw(SessionRecorder::create(out, mcap), kExitRuntime);
     return;
   }
   if (solutions_ && ends_with(out, ".pos")) {

@@ -12,17 +12,13 @@
 
 import fs from "node:fs";
 import path from "node:path";
-import { createRequire } from "node:module";
 import { parse } from "@foxglove/rosmsg";
 import { MessageWriter } from "@foxglove/rosmsg2-serialization";
+import { msgdef } from "./ros2_defs.mjs";
 
-const require = createRequire(import.meta.url);
-const msgdefs = path.join(path.dirname(require.resolve("@foxglove/rosmsg-msgs-common/package.json")), "msgdefs",
-                          "ros2humble");
 const [vioPath, syncPath, outDir] = process.argv.slice(2, 5);
 const bad = process.argv.includes("--bad");
-const writer = new MessageWriter(parse(fs.readFileSync(path.join(msgdefs, "nav_msgs/msg/Odometry.msg"), "utf8"),
-                                       { ros2: true }));
+const writer = new MessageWriter(parse(msgdef("nav_msgs/msg/Odometry"), { ros2: true }));
 
 const rows = (file) => fs.readFileSync(file, "utf8").split("\n").filter((l) => l.trim() !== "");
 const sync = rows(syncPath).slice(1).map((l) => l.split(",")).map((f) => ({

@@ -12,23 +12,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 build=$(cd "${1:?usage: replay_check.sh BUILD_DIR}" && pwd)
 canyon=$build/canyon
 [[ -x $canyon ]] || { echo "error: build canyon first" >&2; exit 1; }
-command -v npm > /dev/null || { echo "SKIP: npm not found (scripts/setup.sh installs it)"; exit 77; }
-decoders=$build/ros2-decoders-replay
-mkdir -p "$decoders"
-cp "$here/package.json" "$here/package-lock.json" "$here"/*.mjs "$decoders/"
-if [[ ! -f $decoders/node_modules/.package-lock.json || $here/package-lock.json -nt $decoders/node_modules/.package-lock.json ]]; then
-  (cd "$decoders" && npm ci --no-audit --no-fund --ignore-scripts --loglevel=error) ||
-    { echo "SKIP: npm ci failed for the MCAP decoders (is the npm registry reachable?)"; exit 77; }
-fi
-
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-domain=$((100 + RANDOM % 100))
+# The decoders, a scratch folder, cleanup on exit, a domain of its own.
+source "$here/common.sh" "$build" ros2-decoders-replay
 "$canyon" simulate -q --scenario downtown --seed 4 --duration 60 --out "$tmp/sim"
 epochs=$(grep -c '^[0-9]' "$tmp/sim/truth.csv")
 rover_config() {  # name: the rover's inputs from DDS, its .pos beside

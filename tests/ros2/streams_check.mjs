@@ -11,31 +11,15 @@
 // Exit 0 pass, 1 fail.
 
 import fs from "node:fs";
-import path from "node:path";
-import { createRequire } from "node:module";
 import { parse } from "@foxglove/rosmsg";
 import { MessageReader } from "@foxglove/rosmsg2-serialization";
 import { check, failures } from "./check.mjs";
+import { frames, msgdef } from "./ros2_defs.mjs";
 
-const require = createRequire(import.meta.url);
-const msgdefs = path.join(path.dirname(require.resolve("@foxglove/rosmsg-msgs-common/package.json")), "msgdefs",
-                          "ros2humble");
-const msgdef = (type) => fs.readFileSync(path.join(msgdefs, type + ".msg"), "utf8");
 // rtcm_msgs/msg/Message.msg of the rtcm_msgs package (not in rosmsg-msgs-common), with the Header it uses.
 const RTCM_MESSAGE = "std_msgs/Header header\nuint8[] message\n" +
   "================================================================================\nMSG: std_msgs/Header\n" +
   msgdef("std_msgs/msg/Header");
-
-function frames(file) {  // canyon_ros2_raw's framing: 4-byte little-endian length, the CDR payload
-  const bytes = fs.readFileSync(file);
-  const out = [];
-  for (let at = 0; at + 4 <= bytes.length;) {
-    const n = bytes.readUInt32LE(at);
-    out.push(bytes.subarray(at + 4, at + 4 + n));
-    at += 4 + n;
-  }
-  return out;
-}
 
 const [mode, a, b, frameId] = process.argv.slice(2);
 const stamp = (m) => BigInt(m.header.stamp.sec) * 1000000000n + BigInt(m.header.stamp.nanosec);

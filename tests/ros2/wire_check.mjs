@@ -7,31 +7,14 @@
 
 import fs from "node:fs";
 import path from "node:path";
-import { createRequire } from "node:module";
 import { parse } from "@foxglove/rosmsg";
 import { MessageReader } from "@foxglove/rosmsg2-serialization";
 import { check, failures } from "./check.mjs";
+import { frames as framesOf, msgdef } from "./ros2_defs.mjs";
 
-const require = createRequire(import.meta.url);
-const msgdefs = path.join(path.dirname(require.resolve("@foxglove/rosmsg-msgs-common/package.json")), "msgdefs",
-                          "ros2humble");
 const dir = process.argv[2];
-
-function reader(type) {  // "sensor_msgs/msg/NavSatFix"
-  const text = fs.readFileSync(path.join(msgdefs, type + ".msg"), "utf8");
-  return new MessageReader(parse(text, { ros2: true }));
-}
-
-function frames(file) {
-  const bytes = fs.readFileSync(path.join(dir, file));
-  const out = [];
-  for (let at = 0; at + 4 <= bytes.length;) {
-    const n = bytes.readUInt32LE(at);
-    out.push(bytes.subarray(at + 4, at + 4 + n));
-    at += 4 + n;
-  }
-  return out;
-}
+const reader = (type) => new MessageReader(parse(msgdef(type), { ros2: true }));  // "sensor_msgs/msg/NavSatFix"
+const frames = (file) => framesOf(path.join(dir, file));
 
 // The rover's .pos: GPST week, tow, lat, lon, h, Q, ns, sdn, sde, sdu, ...
 const GPS_POSIX_S = 315964800, LEAP_S = 18, WEEK_S = 604800;

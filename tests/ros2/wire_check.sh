@@ -17,25 +17,8 @@ build=$(cd "${1:?usage: wire_check.sh BUILD_DIR}" && pwd)
 canyon=$build/canyon
 raw=$build/tests/canyon_ros2_raw
 [[ -x $canyon && -x $raw ]] || { echo "error: build canyon and canyon_ros2_raw first" >&2; exit 1; }
-command -v npm > /dev/null || { echo "SKIP: npm not found (scripts/setup.sh installs it)"; exit 77; }
-
-# The decoders, locked, into the build folder (never the source tree); install scripts are not run.
-decoders=$build/ros2-decoders
-mkdir -p "$decoders"
-cp "$here/package.json" "$here/package-lock.json" "$here"/*.mjs "$decoders/"
-if [[ ! -f $decoders/node_modules/.package-lock.json || $here/package-lock.json -nt $decoders/node_modules/.package-lock.json ]]; then
-  (cd "$decoders" && npm ci --no-audit --no-fund --ignore-scripts --loglevel=error) ||
-    { echo "SKIP: npm ci failed for the ROS 2 decoders (is the npm registry reachable?)"; exit 77; }
-fi
-
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-domain=$((100 + RANDOM % 100))
+# The decoders, a scratch folder, cleanup on exit, a domain of its own.
+source "$here/common.sh" "$build" ros2-decoders
 "$canyon" simulate -q --scenario downtown --seed 3 --duration 60 --out "$tmp/sim"
 epochs=$(grep -c '^[0-9]' "$tmp/sim/truth.csv")
 cat > "$tmp/rover.yaml" << EOF

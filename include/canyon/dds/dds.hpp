@@ -145,7 +145,7 @@ class DdsWriter {
       // On the wire the payload is padded with zeros to a multiple of 4 bytes: record the same bytes.
       std::vector<std::uint8_t> bytes(payload.data, payload.data + payload.length);
       bytes.resize((bytes.size() + 3U) / 4U * 4U, 0);
-      recorder_->record(channel_, std::move(bytes));
+      (void)recorder_->record(channel_, std::move(bytes));  // an error is reported when the recording is closed
     }
     recorder_->add_cpu_ns(thread_cpu_ns() - start);
   }

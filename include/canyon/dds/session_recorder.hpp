@@ -1,10 +1,10 @@
 #pragma once
-// In-process MCAP recording of what a program publishes (canyon rover dds.record): each sample its DdsWriter writes
-// is serialized with the writer's own type support (the same CDR bytes as on the wire, encapsulation header
-// included) and written to the session on the writer's thread, with the channel's schema as canyon record writes it
-// (raw_samples.hpp, recorded_type: by the writer's type, so renamed topics are recorded too). No DDS reader and no
-// second process: what recording costs is the serialization and the file (measured: the thread CPU time spent here,
-// reported by cpu_ns()).
+// An MCAP session being recorded: a channel per topic with its type's OMG IDL schema (raw_samples.hpp,
+// recorded_type; each schema once), a sequence per channel, thread-safe. canyon record writes the samples it takes
+// off the wire into one; canyon rover (dds.record) writes what its DdsWriters publish, each sample serialized with
+// the writer's own type support (the same CDR bytes as on the wire, encapsulation header included) on the writer's
+// thread, by the writer's type, so renamed topics are recorded too: no DDS reader and no second process, so what
+// recording costs is the serialization and the file (measured: the thread CPU time the writers report, cpu_ns()).
 
 #include <atomic>
 #include <cstdint>
@@ -30,8 +30,9 @@ class SessionRecorder {
   /// The channel of `topic`, whose samples are of DDS type `type_name` (its schema by recorded_type()); Error for a
   /// type canyon does not publish.
   Result<std::uint16_t> channel(const std::string& topic, const std::string& type_name);
-  /// One sample's serialized bytes on `channel`, stamped now. Thread-safe; a write error is kept for close().
-  void record(std::uint16_t channel, std::vector<std::uint8_t> bytes);
+  /// One sample's serialized bytes on `channel`, logged now; its publish time `publish_time_ns` (ns since the UNIX
+  /// epoch; 0: now). Thread-safe. The first write error, kept (and returned again) until close().
+  Status record(std::uint16_t channel, std::vector<std::uint8_t> bytes, std::uint64_t publish_time_ns = 0);
   /// Adds `ns` of thread CPU time to what recording cost (the writers time their serialization and record()).
   void add_cpu_ns(std::int64_t ns) { cpu_ns_.fetch_add(ns); }
   /// Writes the summary and closes the file; the first write error, if any.

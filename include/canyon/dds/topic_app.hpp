@@ -127,8 +127,7 @@ class TopicApp {
   std::optional<io::PosWriter> pos_;
   std::optional<io::NmeaWriter> nmea_;
   std::ofstream raw_;
-  std::optional<io::McapWriter> mcap_;
-  std::vector<std::uint32_t> mcap_sequence_;  ///< per channel
+  std::unique_ptr<SessionRecorder> mcap_;  ///< record to .mcap
   pipeline::MonitorModel model_;
   std::vector<std::unique_ptr<AnyReader>> readers_;  ///< last: deleted first, so no callback runs after
   std::atomic<bool> stop_{false};
